@@ -1,0 +1,1 @@
+# Installation and package export are completed by the build/install work; placeholder.

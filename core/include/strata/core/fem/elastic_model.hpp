@@ -1,0 +1,76 @@
+#pragma once
+/// \file elastic_model.hpp
+/// Mesh level: elastic energy Ψ(x) = Σ_t V_t ψ(F_t), forces −∂Ψ/∂x and stiffness ∂²Ψ/∂x² of a
+/// tet mesh, evaluated in parallel (TBB) over rest data precomputed in contiguous arrays.
+///
+/// Positions are 3·#V vertex-major vectors (see types.hpp). The stiffness matrix has a fixed
+/// sparsity pattern built once; `stiffness` only rewrites its values.
+#include <atomic>
+#include <vector>
+
+#include "strata/core/common/types.hpp"
+#include "strata/core/fem/material.hpp"
+#include "strata/core/fem/tet_rest_data.hpp"
+
+namespace strata {
+
+/// Per-tet stress and strain measures for output.
+struct TetFields {
+  Eigen::Matrix<double, Eigen::Dynamic, 6> green_strain;  ///< #T × 6 Voigt [xx yy zz xy yz xz]
+  Eigen::Matrix<double, Eigen::Dynamic, 6> cauchy_stress;  ///< #T × 6 Voigt [Pa]
+  VectorXd von_mises;                                      ///< #T [Pa]
+};
+
+class ElasticModel {
+ public:
+  /// `tets` must be positively oriented and non-degenerate (throws InputError otherwise).
+  ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4i> tets,
+               const Material& material);
+
+  Index num_vertices() const { return m_num_vertices; }
+  Index num_tets() const { return m_tets.rows(); }
+  Index num_dofs() const { return 3 * m_num_vertices; }
+  const MatrixX4i& tets() const { return m_tets; }
+  const Material& material() const { return m_material; }
+  const TetRestData& rest_data() const { return m_rest; }
+  /// Rest positions as a 3·#V vector.
+  const VectorXd& rest_positions() const { return m_rest_positions; }
+
+  /// Ψ(x) [J].
+  double energy(ConstRef<VectorXd> x) const;
+  /// f = −∂Ψ/∂x [N], resized to 3·#V and overwritten.
+  void forces(ConstRef<VectorXd> x, VectorXd& f) const;
+  /// Both at once; returns Ψ(x).
+  double energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const;
+  /// K = ∂²Ψ/∂x² in the fixed pattern of `stiffness_pattern()`; `K` is set to that pattern on the
+  /// first call and only its values are rewritten afterwards. With `project_psd`, each element's
+  /// ∂²ψ/∂F² is projected to PSD first.
+  void stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const;
+  /// The stiffness sparsity pattern (values zero), column-major, 3·#V square.
+  const SparseMatrixd& stiffness_pattern() const { return m_pattern; }
+
+  /// Smallest J = det F over the tets and the index of that tet.
+  std::pair<double, Index> min_volume_ratio(ConstRef<VectorXd> x) const;
+  /// Green strain, Cauchy stress and von Mises stress per tet.
+  TetFields tet_fields(ConstRef<VectorXd> x) const;
+
+  /// Element evaluations so far (each tet visited by energy/forces/stiffness counts once).
+  long long element_evaluations() const { return m_element_evaluations.load(); }
+
+ private:
+  void build_stiffness_pattern();
+
+  Index m_num_vertices;
+  MatrixX4i m_tets;
+  Material m_material;
+  LameParameters m_lame;
+  TetRestData m_rest;
+  VectorXd m_rest_positions;
+  SparseMatrixd m_pattern;
+  /// For tet t, vertex pair (a, b) and column c = 0..2: offset in K's value array of the entry
+  /// (3·v_a, 3·v_b + c); the entries for rows 3·v_a+1, 3·v_a+2 follow it. 48 per tet.
+  std::vector<int> m_block_offsets;
+  mutable std::atomic<long long> m_element_evaluations{0};
+};
+
+}  // namespace strata

@@ -1,0 +1,12 @@
+#pragma once
+/// \file lumped_mass.hpp
+/// Lumped (diagonal) mass: each tet gives a quarter of ρ·V to each of its vertices.
+#include "strata/core/common/types.hpp"
+
+namespace strata {
+
+/// Per-vertex lumped mass [kg], #V entries; sums to ρ · total volume.
+VectorXd lumped_vertex_mass(ConstRef<VectorXd> rest_volume, ConstRef<MatrixX4i> tets,
+                            Index num_vertices, double density);
+
+}  // namespace strata
