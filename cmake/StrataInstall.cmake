@@ -1,1 +1,64 @@
-# Installation and package export are completed by the build/install work; placeholder.
+# Installation and package export: headers, the three shared libraries, the `strata` program, and
+# a relocatable CMake package so another project can `find_package(strata)` and link strata::core,
+# strata::hierarchy and strata::meshing.
+#
+# Installed layout under CMAKE_INSTALL_PREFIX:
+#   include/strata/{core,hierarchy,meshing}/...     public headers
+#   <libdir>/libstrata_{core,hierarchy,meshing}.so  shared libraries (RUNPATH $ORIGIN)
+#   bin/strata                                      command-line program (RUNPATH $ORIGIN/../<libdir>)
+#   <libdir>/cmake/strata/                          strataConfig.cmake, strataConfigVersion.cmake,
+#                                                   strataTargets*.cmake
+#
+# Only Eigen is a public dependency (the headers use it). TBB, nlohmann_json and CHOLMOD are private
+# link dependencies of the shared libraries and do not appear in the exported interface; the
+# warning and tuning targets are BUILD_INTERFACE only.
+include(CMakePackageConfigHelpers)
+include(StrataEigenAbi)
+
+set(STRATA_LIBRARY_TARGETS strata_core strata_hierarchy strata_meshing)
+set(STRATA_CONFIG_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/strata)
+
+# RUNPATH: libraries find each other beside themselves, programs find them in ../<libdir>.
+file(RELATIVE_PATH STRATA_BIN_TO_LIB /strata-prefix/${CMAKE_INSTALL_BINDIR}
+     /strata-prefix/${CMAKE_INSTALL_LIBDIR})
+set(STRATA_PROGRAM_INSTALL_RPATH "$ORIGIN/${STRATA_BIN_TO_LIB}")
+set_target_properties(${STRATA_LIBRARY_TARGETS} PROPERTIES INSTALL_RPATH "$ORIGIN")
+
+install(TARGETS ${STRATA_LIBRARY_TARGETS}
+  EXPORT strataTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime
+          NAMELINK_COMPONENT development
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+foreach(module core hierarchy meshing)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${module}/include/
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT development
+          FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h")
+endforeach()
+
+# The command-line program. experiments/cli may install it itself (then it sets the global property
+# STRATA_CLI_INSTALLED); otherwise it is installed here.
+if(TARGET strata)
+  set_target_properties(strata PROPERTIES INSTALL_RPATH "${STRATA_PROGRAM_INSTALL_RPATH}")
+  get_property(STRATA_CLI_INSTALLED GLOBAL PROPERTY STRATA_CLI_INSTALLED)
+  if(NOT STRATA_CLI_INSTALLED)
+    install(TARGETS strata RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+  endif()
+endif()
+
+install(EXPORT strataTargets
+  NAMESPACE strata::
+  DESTINATION ${STRATA_CONFIG_INSTALL_DIR}
+  COMPONENT development)
+
+configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/strataConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/strataConfig.cmake
+  INSTALL_DESTINATION ${STRATA_CONFIG_INSTALL_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/strataConfigVersion.cmake
+  VERSION ${PROJECT_VERSION}
+  COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/strataConfig.cmake ${PROJECT_BINARY_DIR}/strataConfigVersion.cmake
+  DESTINATION ${STRATA_CONFIG_INSTALL_DIR}
+  COMPONENT development)
