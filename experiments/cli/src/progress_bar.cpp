@@ -1,0 +1,64 @@
+#include "strata/app/progress_bar.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace strata::app {
+
+bool stderr_is_terminal() {
+  return isatty(STDERR_FILENO) == 1;
+}
+
+std::string format_duration(double seconds) {
+  char text[64];
+  if (!std::isfinite(seconds) || seconds < 0.0) return "?";
+  if (seconds < 60.0) {
+    std::snprintf(text, sizeof text, "%.1f s", seconds);
+  } else if (seconds < 3600.0) {
+    const int s = static_cast<int>(seconds);
+    std::snprintf(text, sizeof text, "%d min %02d s", s / 60, s % 60);
+  } else {
+    const int m = static_cast<int>(seconds / 60.0);
+    std::snprintf(text, sizeof text, "%d h %02d min", m / 60, m % 60);
+  }
+  return text;
+}
+
+ProgressBar::ProgressBar(bool enabled)
+    : m_enabled(enabled), m_start(std::chrono::steady_clock::now()), m_last_draw(m_start) {}
+
+ProgressBar::~ProgressBar() {
+  clear();
+}
+
+void ProgressBar::update(double fraction, const std::string& label) {
+  if (!m_enabled) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (m_drawn && now - m_last_draw < std::chrono::milliseconds(100) && fraction < 1.0) return;
+  m_last_draw = now;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const double elapsed = std::chrono::duration<double>(now - m_start).count();
+  const std::string eta =
+      fraction > 0.0 ? format_duration(elapsed * (1.0 - fraction) / fraction) : std::string("?");
+  constexpr int kWidth = 30;
+  const int filled = static_cast<int>(fraction * kWidth);
+  std::string bar(kWidth, ' ');
+  std::fill(bar.begin(), bar.begin() + filled, '=');
+  if (filled < kWidth) bar[filled] = '>';
+  std::fprintf(stderr, "\r[%s] %3d%%  %s  ETA %s\033[K", bar.c_str(),
+               static_cast<int>(fraction * 100.0), label.c_str(), eta.c_str());
+  std::fflush(stderr);
+  m_drawn = true;
+}
+
+void ProgressBar::clear() {
+  if (!m_enabled || !m_drawn) return;
+  std::fprintf(stderr, "\r\033[K");
+  std::fflush(stderr);
+  m_drawn = false;
+}
+
+}  // namespace strata::app

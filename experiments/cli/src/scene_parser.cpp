@@ -1,0 +1,257 @@
+#include "strata/app/scene_parser.hpp"
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "scene_json.hpp"
+#include "strata/app/scene_overrides.hpp"
+
+namespace strata::app {
+namespace {
+
+using detail::SceneValue;
+
+Region parse_region(const SceneValue& value) {
+  value.expect_object({"box", "plane", "sphere"});
+  const int kinds = value.has("box") + value.has("plane") + value.has("sphere");
+  if (kinds != 1) value.fail("must have exactly one of box, plane, sphere");
+  if (value.has("box")) {
+    const SceneValue box = value.at("box");
+    box.expect_object({"min", "max"});
+    BoxRegion region{box.at("min").vec3(), box.at("max").vec3()};
+    if ((region.min.array() > region.max.array()).any()) {
+      box.at("max").fail("must be >= min in every coordinate");
+    }
+    return region;
+  }
+  if (value.has("plane")) {
+    const SceneValue plane = value.at("plane");
+    plane.expect_object({"point", "normal", "tolerance"});
+    PlaneRegion region;
+    region.point = plane.at("point").vec3();
+    region.normal = plane.at("normal").nonzero_vec3();
+    region.distance = plane.has("tolerance") ? plane.at("tolerance").non_negative() : 0.0;
+    return region;
+  }
+  const SceneValue sphere = value.at("sphere");
+  sphere.expect_object({"center", "radius"});
+  return SphereRegion{sphere.at("center").vec3(), sphere.at("radius").non_negative()};
+}
+
+MeshSpec parse_mesh(const SceneValue& value, const std::filesystem::path& folder) {
+  value.expect_object({"file", "box"});
+  if (value.has("file") == value.has("box")) value.fail("must have exactly one of file, box");
+  MeshSpec mesh;
+  if (value.has("file")) {
+    const SceneValue file = value.at("file");
+    const std::string name = file.string();
+    if (name.empty()) file.fail("must not be empty");
+    const std::filesystem::path path(name);
+    mesh.file = path.is_absolute() ? path : folder / path;
+    return mesh;
+  }
+  const SceneValue box = value.at("box");
+  box.expect_object({"min", "max", "cells"});
+  mesh.box_min = box.at("min").vec3();
+  mesh.box_max = box.at("max").vec3();
+  if ((mesh.box_min.array() >= mesh.box_max.array()).any()) {
+    box.at("max").fail("must be > min in every coordinate");
+  }
+  mesh.box_cells = box.at("cells").int3(1);
+  return mesh;
+}
+
+Material parse_material(const SceneValue& value) {
+  value.expect_object({"model", "youngs_modulus", "poisson_ratio", "density", "damping"});
+  Material material;
+  const int model = value.at("model").choice({"stvk", "corotated", "neohookean"});
+  material.model = static_cast<MaterialModel>(model);
+  material.youngs_modulus = value.at("youngs_modulus").positive();
+  const SceneValue nu = value.at("poisson_ratio");
+  material.poisson_ratio = nu.number();
+  if (material.poisson_ratio < 0.0 || material.poisson_ratio >= 0.5) nu.fail("must be in [0, 0.5)");
+  material.density = value.at("density").positive();
+  if (value.has("damping")) {
+    const SceneValue damping = value.at("damping");
+    damping.expect_object({"mass", "stiffness"});
+    if (damping.has("mass")) material.mass_damping = damping.at("mass").non_negative();
+    if (damping.has("stiffness")) {
+      material.stiffness_damping = damping.at("stiffness").non_negative();
+    }
+  }
+  return material;
+}
+
+PrescribedSpec parse_prescribed(const SceneValue& value) {
+  value.expect_object({"region", "displacement", "rotation"});
+  PrescribedSpec spec;
+  spec.region = parse_region(value.at("region"));
+  if (value.has("displacement") == value.has("rotation")) {
+    value.fail("must have exactly one of displacement, rotation");
+  }
+  if (value.has("displacement")) {
+    spec.displacement = value.at("displacement").vec3();
+    return spec;
+  }
+  const SceneValue rotation = value.at("rotation");
+  rotation.expect_object({"axis", "center", "angle_degrees"});
+  spec.is_rotation = true;
+  spec.axis = rotation.at("axis").nonzero_vec3().normalized();
+  spec.center = rotation.at("center").vec3();
+  spec.angle_degrees = rotation.at("angle_degrees").number();
+  return spec;
+}
+
+SolverSpec parse_solver(const SceneValue& value) {
+  value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "newton_tolerance",
+                       "max_newton_iterations"});
+  SolverSpec solver;
+  solver.mode = static_cast<SolverMode>(value.at("mode").choice({"dynamic", "static"}));
+  if (value.has("integrator")) {
+    solver.integrator = static_cast<IntegratorKind>(
+        value.at("integrator").choice({"symplectic_euler", "rk4", "implicit_euler"}));
+  }
+  if (solver.mode == SolverMode::dynamic) {
+    solver.dt = value.at("dt").positive();
+    solver.duration = value.at("duration").positive();
+  } else {
+    if (value.has("dt")) solver.dt = value.at("dt").positive();
+    if (value.has("duration")) solver.duration = value.at("duration").positive();
+  }
+  if (value.has("load_steps")) solver.load_steps = value.at("load_steps").integer(1);
+  if (value.has("newton_tolerance")) {
+    solver.newton_tolerance = value.at("newton_tolerance").positive();
+  }
+  if (value.has("max_newton_iterations")) {
+    solver.max_newton_iterations = value.at("max_newton_iterations").integer(1);
+  }
+  return solver;
+}
+
+OutputSpec parse_output(const SceneValue& value) {
+  value.expect_object({"every", "probes", "vtk"});
+  OutputSpec output;
+  if (value.has("every")) output.every = value.at("every").integer(1);
+  if (value.has("probes")) {
+    for (const SceneValue& probe : value.at("probes").elements()) {
+      output.probes.push_back(probe.vec3());
+    }
+  }
+  if (value.has("vtk")) output.vtk = value.at("vtk").boolean();
+  return output;
+}
+
+}  // namespace
+
+SceneKeyError::SceneKeyError(const std::string& file, std::string key_path, const std::string& what,
+                             bool unknown_key)
+    : InputError(file + ": " + (key_path.empty() ? std::string("scene") : key_path) + ": " + what),
+      m_key_path(std::move(key_path)),
+      m_unknown_key(unknown_key) {}
+
+nlohmann::json read_json_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open (no such file or not readable)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    return nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::parse_error& error) {
+    // "[json.exception.parse_error.101] parse error at line 3, column 7: syntax error ..."
+    const std::string what = error.what();
+    std::smatch match;
+    static const std::regex pattern(R"(at line (\d+), column (\d+): (.*))");
+    if (std::regex_search(what, match, pattern)) {
+      throw InputError(file.string() + ": line " + match[1].str() + ", column " + match[2].str() +
+                       ": " + match[3].str());
+    }
+    throw InputError(file.string() + ": malformed JSON at byte " + std::to_string(error.byte) +
+                     ": " + what);
+  }
+}
+
+Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file) {
+  const std::string file_name = file.string();
+  const SceneValue top(root, "", file_name);
+  top.expect_object({"mesh", "material", "gravity", "fixed", "prescribed", "forces", "ground",
+                     "solver", "output"});
+  Scene scene;
+  scene.file = file;
+  scene.name = file.stem().string();
+  scene.mesh = parse_mesh(top.at("mesh"), file.parent_path());
+  scene.material = parse_material(top.at("material"));
+  if (top.has("gravity")) scene.gravity = top.at("gravity").vec3();
+  if (top.has("fixed")) {
+    for (const SceneValue& entry : top.at("fixed").elements()) {
+      scene.fixed.push_back(parse_region(entry));
+    }
+  }
+  if (top.has("prescribed")) {
+    for (const SceneValue& entry : top.at("prescribed").elements()) {
+      scene.prescribed.push_back(parse_prescribed(entry));
+    }
+  }
+  if (top.has("forces")) {
+    for (const SceneValue& entry : top.at("forces").elements()) {
+      entry.expect_object({"region", "total_force"});
+      scene.forces.push_back({parse_region(entry.at("region")), entry.at("total_force").vec3()});
+    }
+  }
+  if (top.has("ground")) {
+    const SceneValue ground = top.at("ground");
+    ground.expect_object({"point", "normal", "friction"});
+    GroundSpec spec;
+    spec.point = ground.at("point").vec3();
+    spec.normal = ground.at("normal").nonzero_vec3().normalized();
+    if (ground.has("friction")) spec.friction = ground.at("friction").non_negative();
+    scene.ground = spec;
+  }
+  scene.solver = parse_solver(top.at("solver"));
+  if (top.has("output")) scene.output = parse_output(top.at("output"));
+  if (scene.solver.mode == SolverMode::quasi_static && scene.fixed.empty() &&
+      scene.prescribed.empty()) {
+    throw SceneKeyError(file_name, "fixed",
+                        "static mode needs at least one fixed or prescribed group", false);
+  }
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  nlohmann::json root = read_json_file(file);
+  std::vector<SceneOverride> parsed;
+  for (const std::string& text : overrides) {
+    parsed.push_back(parse_override(text));
+    apply_override(root, parsed.back());
+  }
+  try {
+    return parse_scene(root, file);
+  } catch (const SceneKeyError& error) {
+    if (!error.unknown_key()) throw;
+    for (const SceneOverride& override_ : parsed) {
+      const std::string& key = error.key_path();
+      if (override_.path == key || override_.path.rfind(key + ".", 0) == 0) {
+        throw InputError("--set " + override_.path + ": unknown key " + key);
+      }
+    }
+    throw;
+  }
+}
+
+std::string to_string(SolverMode mode) {
+  return mode == SolverMode::dynamic ? "dynamic" : "static";
+}
+
+std::string to_string(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::symplectic_euler:
+      return "symplectic_euler";
+    case IntegratorKind::rk4:
+      return "rk4";
+    case IntegratorKind::implicit_euler:
+      return "implicit_euler";
+  }
+  return "?";
+}
+
+}  // namespace strata::app
