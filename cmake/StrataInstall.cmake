@@ -19,9 +19,6 @@ set(STRATA_LIBRARY_TARGETS strata_core strata_hierarchy strata_meshing)
 set(STRATA_CONFIG_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/strata)
 
 # RUNPATH: libraries find each other beside themselves, programs find them in ../<libdir>.
-file(RELATIVE_PATH STRATA_BIN_TO_LIB /strata-prefix/${CMAKE_INSTALL_BINDIR}
-     /strata-prefix/${CMAKE_INSTALL_LIBDIR})
-set(STRATA_PROGRAM_INSTALL_RPATH "$ORIGIN/${STRATA_BIN_TO_LIB}")
 set_target_properties(${STRATA_LIBRARY_TARGETS} PROPERTIES INSTALL_RPATH "$ORIGIN")
 
 install(TARGETS ${STRATA_LIBRARY_TARGETS}
@@ -38,15 +35,8 @@ foreach(module core hierarchy meshing)
           FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h")
 endforeach()
 
-# The command-line program. experiments/cli may install it itself (then it sets the global property
-# STRATA_CLI_INSTALLED); otherwise it is installed here.
-if(TARGET strata)
-  set_target_properties(strata PROPERTIES INSTALL_RPATH "${STRATA_PROGRAM_INSTALL_RPATH}")
-  get_property(STRATA_CLI_INSTALLED GLOBAL PROPERTY STRATA_CLI_INSTALLED)
-  if(NOT STRATA_CLI_INSTALLED)
-    install(TARGETS strata RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-  endif()
-endif()
+# The command-line program `strata` is installed by experiments/cli/CMakeLists.txt (RUNPATH
+# $ORIGIN/../<libdir>); install it here only if that file stops doing so.
 
 install(EXPORT strataTargets
   NAMESPACE strata::

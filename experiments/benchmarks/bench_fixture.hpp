@@ -1,0 +1,63 @@
+#pragma once
+/// \file bench_fixture.hpp
+/// Shared set-up of the benchmarks: box meshes of ~50k and ~400k tets, a smooth deformed state and
+/// a cache holding the most recently built ElasticModel (building the stiffness pattern of the
+/// large mesh takes longer than one measurement).
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <strata/core/fem/elastic_model.hpp>
+#include <strata/core/fem/material.hpp>
+#include <strata/core/mesh/tet_mesh.hpp>
+
+namespace strata::bench {
+
+/// A benchmark mesh: `cells` box cells, 6 tets each, over [0, cells·h]³ with h = 1/cells[0] m.
+struct MeshSize {
+  std::array<int, 3> cells;
+  long long num_tets() const { return 6LL * cells[0] * cells[1] * cells[2]; }
+};
+
+/// 20×20×21 cells = 50,400 tets; 40×40×42 cells = 403,200 tets.
+inline const std::vector<MeshSize>& mesh_sizes() {
+  static const std::vector<MeshSize> sizes = {{{20, 20, 21}}, {{40, 40, 42}}};
+  return sizes;
+}
+
+inline const std::vector<MaterialModel>& material_models() {
+  static const std::vector<MaterialModel> models = {MaterialModel::stvk, MaterialModel::corotated,
+                                                    MaterialModel::neohookean};
+  return models;
+}
+
+inline const std::vector<int>& thread_counts() {
+  static const std::vector<int> threads = {1, 2};
+  return threads;
+}
+
+/// "<prefix>/tets:<#T>/threads:<n>".
+inline std::string benchmark_name(const std::string& prefix, const MeshSize& size, int threads) {
+  return prefix + "/tets:" + std::to_string(size.num_tets()) +
+         "/threads:" + std::to_string(threads);
+}
+
+/// Box mesh of the given size with cubic cells of edge 1/cells[0] m.
+TetMesh benchmark_mesh(const MeshSize& size);
+
+/// Rest positions plus a smooth displacement of ~1 % of the box size (3·#V).
+VectorXd deformed_positions(const TetMesh& mesh);
+
+/// A rubber-like material: E = 1 MPa, ν = 0.3, ρ = 1000 kg/m³.
+Material benchmark_material(MaterialModel model);
+
+/// The mesh and elastic model for (size, model); the last one built is kept and reused.
+struct ModelCase {
+  TetMesh mesh;
+  std::unique_ptr<ElasticModel> model;
+  VectorXd deformed;
+};
+const ModelCase& model_case(const MeshSize& size, MaterialModel model);
+
+}  // namespace strata::bench

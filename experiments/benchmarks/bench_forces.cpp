@@ -1,0 +1,39 @@
+// Internal-force evaluation f = −∂Ψ/∂x: throughput in tets/s (items_per_second) for each material
+// model, mesh size and thread count. Names: forces/<model>/tets:<#T>/threads:<n>.
+#include <benchmark/benchmark.h>
+
+#include <strata/core/common/parallel.hpp>
+
+#include "bench_fixture.hpp"
+
+namespace strata::bench {
+namespace {
+
+void forces_benchmark(benchmark::State& state, MeshSize size, MaterialModel material, int threads) {
+  const ThreadLimit limit(threads);
+  const ModelCase& c = model_case(size, material);
+  VectorXd f(c.model->num_dofs());
+  for (auto _ : state) {
+    c.model->forces(c.deformed, f);
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * c.model->num_tets());
+  state.counters["tets"] = double(c.model->num_tets());
+  state.counters["threads"] = threads;
+}
+
+const bool registered = [] {
+  for (const MeshSize& size : mesh_sizes())
+    for (MaterialModel material : material_models())
+      for (int threads : thread_counts())
+        benchmark::RegisterBenchmark(
+            benchmark_name("forces/" + to_string(material), size, threads).c_str(),
+            forces_benchmark, size, material, threads)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+  return true;
+}();
+
+}  // namespace
+}  // namespace strata::bench

@@ -1,0 +1,96 @@
+// One backward-Euler step (ImplicitEuler, Newton + CHOLMOD) of a box clamped at x = 0 under
+// gravity, starting from rest each time: wall time per step and tets/s. The symbolic analysis of
+// the linear solver happens in an untimed warm-up step; the timed steps reuse it like a running
+// simulation. CHOLMOD's BLAS threads are not limited by ThreadLimit. Names:
+// implicit_euler_step/<model>/tets:<#T>/threads:<n>.
+#include <benchmark/benchmark.h>
+
+#include <strata/core/common/parallel.hpp>
+#include <strata/core/fem/lumped_mass.hpp>
+#include <strata/core/sim/dirichlet.hpp>
+#include <strata/core/sim/dynamics_system.hpp>
+#include <strata/core/sim/implicit_euler.hpp>
+#include <strata/core/sim/loads.hpp>
+#include <strata/core/sim/region.hpp>
+#include <strata/core/sim/solver_settings.hpp>
+
+#include "bench_fixture.hpp"
+
+namespace strata::bench {
+namespace {
+
+void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialModel material,
+                             int threads) {
+  const ThreadLimit limit(threads);
+  const ModelCase& c = model_case(size, material);
+  const ElasticModel& model = *c.model;
+  const Material& mat = model.material();
+
+  const VectorXd vertex_mass = lumped_vertex_mass(model.rest_data().rest_volume, model.tets(),
+                                                  model.num_vertices(), mat.density);
+  VectorXd dof_mass(model.num_dofs());
+  for (Index v = 0; v < model.num_vertices(); ++v)
+    dof_mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
+  const VectorXd f_ext = gravity_forces(vertex_mass, Vector3d(0.0, 0.0, -9.81));
+
+  const double tolerance = region_tolerance(c.mesh.vertices);
+  DirichletSpec clamp;
+  clamp.name = "fixed[0]";
+  clamp.region = PlaneRegion{Vector3d::Zero(), Vector3d::UnitX(), 0.0};
+  const std::vector<DirichletGroup> groups =
+      resolve_dirichlet_groups({clamp}, c.mesh.vertices, tolerance);
+  const std::vector<char> constrained = dirichlet_dof_mask(groups, model.num_vertices());
+  const auto [lo, hi] = bounding_box(c.mesh.vertices);
+
+  const SolverSettings settings;
+  const DynamicsSystem system{model,
+                              dof_mass,
+                              f_ext,
+                              mat.mass_damping,
+                              mat.stiffness_damping,
+                              groups,
+                              constrained,
+                              /*ramp_time=*/1.0,
+                              (hi - lo).norm()};
+  ImplicitEuler stepper(system, LinearSolverKind::cholmod, settings.max_newton_iterations,
+                        settings.newton_tolerance);
+
+  const VectorXd rest = model.rest_positions();
+  VectorXd x = rest;
+  VectorXd v = VectorXd::Zero(model.num_dofs());
+  stepper.step(0.0, settings.dt, x, v);  // warm-up: symbolic analysis
+
+  long newton_iterations = 0;
+  bool converged = true;
+  for (auto _ : state) {
+    x = rest;
+    v.setZero();
+    const NewtonResult result = stepper.step(0.0, settings.dt, x, v);
+    newton_iterations += result.iterations;
+    converged = converged && result.converged;
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.SetItemsProcessed(state.iterations() * model.num_tets());
+  state.counters["tets"] = double(model.num_tets());
+  state.counters["threads"] = threads;
+  state.counters["dofs"] = double(model.num_dofs());
+  state.counters["newton_iterations"] = double(newton_iterations) / double(state.iterations());
+  state.counters["dt"] = settings.dt;
+  if (!converged) state.SkipWithError("Newton did not converge");
+}
+
+const bool registered = [] {
+  for (const MeshSize& size : mesh_sizes())
+    for (MaterialModel material : material_models())
+      for (int threads : thread_counts()) {
+        benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+            benchmark_name("implicit_euler_step/" + to_string(material), size, threads).c_str(),
+            implicit_step_benchmark, size, material, threads);
+        b->Unit(benchmark::kMillisecond)->UseRealTime();
+        if (size.num_tets() > 100000) b->Iterations(1);
+      }
+  return true;
+}();
+
+}  // namespace
+}  // namespace strata::bench
