@@ -1,3 +1,119 @@
-int main() {
-  return 0;
+// strata: run scenes, inspect and convert tet meshes. Exit codes: 0 ok, 2 bad input, 3 diverged.
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "strata/app/progress_bar.hpp"
+#include "strata/app/scene_parser.hpp"
+#include "strata/app/scene_runner.hpp"
+#include "strata/core/common/error.hpp"
+#include "strata/core/io/mesh_io.hpp"
+#include "strata/core/mesh/mesh_quality.hpp"
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitBadInput = 2;
+constexpr int kExitDiverged = 3;
+
+int fail(const std::string& message, int code) {
+  std::cerr << "strata: error: " << message << std::endl;
+  return code;
+}
+
+/// `strata info`: counts, volume and quality of a mesh file, or of a scene's mesh.
+int run_info(const std::filesystem::path& path) {
+  strata::TetMesh mesh;
+  std::string source = path.string();
+  if (path.extension() == ".json") {
+    const strata::app::Scene scene = strata::app::load_scene(path, {});
+    strata::app::PreparedMesh prepared = strata::app::prepare_scene_mesh(scene);
+    mesh = std::move(prepared.mesh);
+    source += " (mesh " + prepared.source + ")";
+  } else {
+    mesh = strata::read_tet_mesh(path);
+  }
+  const strata::Index num_vertices = mesh.vertices.rows();
+  for (strata::Index t = 0; t < mesh.tets.rows(); ++t) {
+    for (int k = 0; k < 4; ++k) {
+      if (mesh.tets(t, k) < 0 || mesh.tets(t, k) >= num_vertices) {
+        throw strata::InputError(path.string() + ": tet " + std::to_string(t) +
+                                 " has a vertex index out of range");
+      }
+    }
+  }
+  std::cout << source << "\n"
+            << strata::format_mesh_quality(strata::compute_mesh_quality(mesh)) << std::flush;
+  strata::validate_tet_mesh(mesh, path.string());
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"strata: tetrahedral FEM simulation of deformable solids"};
+  app.require_subcommand(1);
+
+  CLI::App* run = app.add_subcommand("run", "Run a scene file and write its outputs");
+  std::string scene_file;
+  std::string out_dir;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  run->add_option("scene", scene_file, "Scene file (JSON)")->required();
+  run->add_option("--out", out_dir, "Output folder (default: <scene folder>/out/<scene name>)");
+  run->add_option("--set", overrides,
+                  "Override a scene key: key.path=value (value as JSON, else a string); "
+                  "repeatable, e.g. --set solver.dt=1e-4 --set fixed.0.box.max=[0,1,1]")
+      ->take_last()
+      ->expected(1);
+  run->add_flag("-q,--quiet", quiet, "No progress bar, info lines or summary");
+
+  CLI::App* info = app.add_subcommand("info", "Print counts, volume and quality of a tet mesh");
+  std::string info_file;
+  info->add_option("mesh", info_file, "Mesh file (.msh, .mesh, .node/.ele, .vtu) or scene (.json)")
+      ->required();
+
+  CLI::App* convert = app.add_subcommand("convert", "Convert a tet mesh between file formats");
+  std::string convert_in, convert_out;
+  convert->add_option("input", convert_in, "Input mesh file")->required();
+  convert->add_option("output", convert_out, "Output mesh file (format from the extension)")
+      ->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& error) {
+    return app.exit(error);
+  } catch (const CLI::CallForAllHelp& error) {
+    return app.exit(error);
+  } catch (const CLI::ParseError& error) {
+    return fail(error.what(), kExitBadInput);
+  }
+
+  try {
+    if (*run) {
+      const strata::app::Scene scene = strata::app::load_scene(scene_file, overrides);
+      strata::app::RunOptions options;
+      options.output_dir = out_dir;
+      options.quiet = quiet;
+      options.progress = !quiet && strata::app::stderr_is_terminal();
+      strata::app::run_scene(scene, options);
+    } else if (*info) {
+      return run_info(info_file);
+    } else if (*convert) {
+      strata::convert_tet_mesh(convert_in, convert_out);
+      std::cout << "strata: wrote " << convert_out << std::endl;
+    }
+  } catch (const strata::DivergenceError& error) {
+    return fail(error.what(), kExitDiverged);
+  } catch (const strata::InputError& error) {
+    return fail(error.what(), kExitBadInput);
+  } catch (const std::filesystem::filesystem_error& error) {
+    return fail(error.what(), kExitBadInput);
+  } catch (const std::exception& error) {
+    return fail(std::string("internal error: ") + error.what(), 1);
+  }
+  return kExitOk;
 }

@@ -12,6 +12,8 @@ namespace {
 
 using detail::SceneValue;
 
+constexpr double kPi = 3.14159265358979323846;
+
 Region parse_region(const SceneValue& value) {
   value.expect_object({"box", "plane", "sphere"});
   const int kinds = value.has("box") + value.has("plane") + value.has("sphere");
@@ -83,36 +85,39 @@ Material parse_material(const SceneValue& value) {
   return material;
 }
 
-PrescribedSpec parse_prescribed(const SceneValue& value) {
+DirichletSpec parse_prescribed(const SceneValue& value) {
   value.expect_object({"region", "displacement", "rotation"});
-  PrescribedSpec spec;
+  DirichletSpec spec;
+  spec.name = value.path();
   spec.region = parse_region(value.at("region"));
   if (value.has("displacement") == value.has("rotation")) {
     value.fail("must have exactly one of displacement, rotation");
   }
   if (value.has("displacement")) {
+    spec.kind = DirichletKind::displacement;
     spec.displacement = value.at("displacement").vec3();
     return spec;
   }
   const SceneValue rotation = value.at("rotation");
   rotation.expect_object({"axis", "center", "angle_degrees"});
-  spec.is_rotation = true;
+  spec.kind = DirichletKind::rotation;
   spec.axis = rotation.at("axis").nonzero_vec3().normalized();
+  spec.has_center = true;
   spec.center = rotation.at("center").vec3();
-  spec.angle_degrees = rotation.at("angle_degrees").number();
+  spec.angle = rotation.at("angle_degrees").number() * kPi / 180.0;
   return spec;
 }
 
-SolverSpec parse_solver(const SceneValue& value) {
-  value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "newton_tolerance",
-                       "max_newton_iterations"});
-  SolverSpec solver;
-  solver.mode = static_cast<SolverMode>(value.at("mode").choice({"dynamic", "static"}));
+SolverSettings parse_solver(const SceneValue& value) {
+  value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "linear_solver",
+                       "newton_tolerance", "max_newton_iterations"});
+  SolverSettings solver;
+  solver.mode = static_cast<SimulationMode>(value.at("mode").choice({"dynamic", "static"}));
   if (value.has("integrator")) {
-    solver.integrator = static_cast<IntegratorKind>(
+    solver.integrator = static_cast<Integrator>(
         value.at("integrator").choice({"symplectic_euler", "rk4", "implicit_euler"}));
   }
-  if (solver.mode == SolverMode::dynamic) {
+  if (solver.mode == SimulationMode::dynamic) {
     solver.dt = value.at("dt").positive();
     solver.duration = value.at("duration").positive();
   } else {
@@ -120,6 +125,10 @@ SolverSpec parse_solver(const SceneValue& value) {
     if (value.has("duration")) solver.duration = value.at("duration").positive();
   }
   if (value.has("load_steps")) solver.load_steps = value.at("load_steps").integer(1);
+  if (value.has("linear_solver")) {
+    solver.linear_solver =
+        static_cast<LinearSolverKind>(value.at("linear_solver").choice({"cholmod", "cg"}));
+  }
   if (value.has("newton_tolerance")) {
     solver.newton_tolerance = value.at("newton_tolerance").positive();
   }
@@ -184,7 +193,10 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   if (top.has("gravity")) scene.gravity = top.at("gravity").vec3();
   if (top.has("fixed")) {
     for (const SceneValue& entry : top.at("fixed").elements()) {
-      scene.fixed.push_back(parse_region(entry));
+      DirichletSpec spec;
+      spec.name = entry.path();
+      spec.region = parse_region(entry);
+      scene.fixed.push_back(spec);
     }
   }
   if (top.has("prescribed")) {
@@ -195,13 +207,14 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   if (top.has("forces")) {
     for (const SceneValue& entry : top.at("forces").elements()) {
       entry.expect_object({"region", "total_force"});
-      scene.forces.push_back({parse_region(entry.at("region")), entry.at("total_force").vec3()});
+      scene.forces.push_back(
+          {entry.path(), parse_region(entry.at("region")), entry.at("total_force").vec3()});
     }
   }
   if (top.has("ground")) {
     const SceneValue ground = top.at("ground");
     ground.expect_object({"point", "normal", "friction"});
-    GroundSpec spec;
+    GroundPlane spec;
     spec.point = ground.at("point").vec3();
     spec.normal = ground.at("normal").nonzero_vec3().normalized();
     if (ground.has("friction")) spec.friction = ground.at("friction").non_negative();
@@ -209,7 +222,7 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   }
   scene.solver = parse_solver(top.at("solver"));
   if (top.has("output")) scene.output = parse_output(top.at("output"));
-  if (scene.solver.mode == SolverMode::quasi_static && scene.fixed.empty() &&
+  if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {
     throw SceneKeyError(file_name, "fixed",
                         "static mode needs at least one fixed or prescribed group", false);
@@ -238,20 +251,10 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<std::strin
   }
 }
 
-std::string to_string(SolverMode mode) {
-  return mode == SolverMode::dynamic ? "dynamic" : "static";
-}
-
-std::string to_string(IntegratorKind kind) {
-  switch (kind) {
-    case IntegratorKind::symplectic_euler:
-      return "symplectic_euler";
-    case IntegratorKind::rk4:
-      return "rk4";
-    case IntegratorKind::implicit_euler:
-      return "implicit_euler";
-  }
-  return "?";
+std::vector<DirichletSpec> Scene::dirichlet_groups() const {
+  std::vector<DirichletSpec> groups = fixed;
+  groups.insert(groups.end(), prescribed.begin(), prescribed.end());
+  return groups;
 }
 
 }  // namespace strata::app

@@ -1,0 +1,55 @@
+#pragma once
+/// \file scene_runner.hpp
+/// Runs a scene: builds the mesh (read or box → validate_tet_mesh → drop unreferenced vertices →
+/// orient_tets), the Simulation, locates the probes, then steps to the end writing probes.csv,
+/// reactions.csv, the VTK series and stats.json into the output folder.
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+
+#include "strata/app/scene.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+
+namespace strata::app {
+
+/// The scene's mesh, ready for simulation.
+struct PreparedMesh {
+  TetMesh mesh;
+  std::string source;          ///< the mesh file or "box"
+  Index removed_vertices = 0;  ///< vertices no tet referenced
+  Index reoriented_tets = 0;   ///< tets flipped to positive orientation
+};
+
+/// Reads (or builds) and prepares the scene's mesh. InputErrors name the scene file and key
+/// ("scene.json: mesh.file: <reader message naming the mesh file>").
+PreparedMesh prepare_scene_mesh(const Scene& scene);
+
+struct RunOptions {
+  std::filesystem::path output_dir;  ///< empty: default_output_dir(scene)
+  bool quiet = false;                ///< no info lines and no summary (warnings still print)
+  bool progress = false;             ///< draw a progress bar on stderr
+  std::ostream* log = nullptr;       ///< info and summary lines (nullptr: std::cout)
+};
+
+struct RunSummary {
+  std::string status = "ok";  ///< "ok" | "diverged"
+  std::string message;        ///< the divergence message
+  long steps = 0;
+  int frames = 0;
+  double wall_seconds = 0.0;
+  double stable_dt_estimate = 0.0;
+  std::filesystem::path output_dir;
+};
+
+/// `<scene folder>/out/<scene stem>`.
+std::filesystem::path default_output_dir(const Scene& scene);
+
+/// Tolerance for locating probes: 1e-3 × the rest mesh's bounding-box diagonal.
+inline constexpr double kProbeToleranceFactor = 1e-3;
+
+/// Runs the scene and writes its outputs. Throws InputError for bad input (before any step) and
+/// DivergenceError if the run diverges — after writing everything up to the last good frame and
+/// stats.json with status "diverged".
+RunSummary run_scene(const Scene& scene, const RunOptions& options);
+
+}  // namespace strata::app

@@ -1,0 +1,32 @@
+#pragma once
+/// \file vtk_series.hpp
+/// ParaView output of a run: `<stem>.pvd` plus one `<stem>_NNNNNN.vtu` per frame, with point data
+/// displacement and velocity (#V × 3) and cell data green_strain and stress (Cauchy, Voigt 6:
+/// xx yy zz xy yz xz), von_mises and level (0 for single-level meshes).
+#include <filesystem>
+#include <string>
+
+#include "strata/core/io/pvd.hpp"
+#include "strata/core/sim/simulation.hpp"
+
+namespace strata::app {
+
+class VtkSeries {
+ public:
+  /// Removes frames `<stem>_NNNNNN.vtu` of an older run in `folder` and starts an empty .pvd.
+  VtkSeries(const std::filesystem::path& folder, const std::string& stem);
+
+  /// Writes the simulation's current state as the next frame at `time` (load factor when static).
+  void write_frame(double time, const Simulation& simulation);
+
+  int num_frames() const { return m_frames; }
+  const std::filesystem::path& pvd_path() const { return m_pvd.path(); }
+
+ private:
+  std::filesystem::path m_folder;
+  std::string m_stem;
+  PvdWriter m_pvd;
+  int m_frames = 0;
+};
+
+}  // namespace strata::app

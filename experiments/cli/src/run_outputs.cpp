@@ -1,0 +1,86 @@
+#include "strata/app/run_outputs.hpp"
+
+#include <sstream>
+
+#include "strata/core/io/atomic_file.hpp"
+#include "strata/core/io/number_text.hpp"
+
+namespace strata::app {
+
+std::string format_double(double value) {
+  std::ostringstream out;
+  write_double(out, value);
+  return out.str();
+}
+
+CsvSeries::CsvSeries(std::filesystem::path path, std::string header, double save_interval)
+    : m_path(std::move(path)),
+      m_header(std::move(header)),
+      m_save_interval(save_interval),
+      m_last_save(std::chrono::steady_clock::now()) {}
+
+void CsvSeries::add_row(std::string row) {
+  m_rows.push_back(std::move(row));
+}
+
+void CsvSeries::save_if_due() {
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - m_last_save).count() >= m_save_interval) save();
+}
+
+void CsvSeries::save() {
+  write_file_atomically(m_path, [this](std::ostream& out) {
+    out << m_header << '\n';
+    for (const std::string& row : m_rows)
+      out << row << '\n';
+  });
+  m_last_save = std::chrono::steady_clock::now();
+}
+
+ProbeRecorder::ProbeRecorder(const std::filesystem::path& path, const TetMesh& rest_mesh,
+                             std::vector<Vector3d> probes, std::vector<TetLocation> locations)
+    : m_csv(path, "time,probe,x,y,z,ux,uy,uz"),
+      m_tets(rest_mesh.tets),
+      m_probes(std::move(probes)),
+      m_locations(std::move(locations)) {}
+
+Vector3d ProbeRecorder::probe_displacement(std::size_t i, ConstRef<VectorXd> displacement) const {
+  const TetLocation& location = m_locations[i];
+  Vector3d u = Vector3d::Zero();
+  for (int k = 0; k < 4; ++k) {
+    u += location.barycentric(k) * displacement.segment<3>(3 * m_tets(location.tet, k));
+  }
+  return u;
+}
+
+void ProbeRecorder::record(double time, ConstRef<VectorXd> displacement) {
+  for (std::size_t i = 0; i < m_probes.size(); ++i) {
+    const Vector3d u = probe_displacement(i, displacement);
+    std::ostringstream row;
+    write_double(row, time);
+    row << ',' << i;
+    for (int a = 0; a < 3; ++a)
+      row << ',' << format_double(m_probes[i](a));
+    for (int a = 0; a < 3; ++a)
+      row << ',' << format_double(u(a));
+    m_csv.add_row(row.str());
+  }
+}
+
+ReactionRecorder::ReactionRecorder(const std::filesystem::path& path)
+    : m_csv(path, "time,group,fx,fy,fz,mx,my,mz") {}
+
+void ReactionRecorder::record(double time, const std::vector<GroupReaction>& reactions) {
+  for (std::size_t g = 0; g < reactions.size(); ++g) {
+    std::ostringstream row;
+    write_double(row, time);
+    row << ',' << g;
+    for (int a = 0; a < 3; ++a)
+      row << ',' << format_double(reactions[g].force(a));
+    for (int a = 0; a < 3; ++a)
+      row << ',' << format_double(reactions[g].moment(a));
+    m_csv.add_row(row.str());
+  }
+}
+
+}  // namespace strata::app

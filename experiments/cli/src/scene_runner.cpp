@@ -1,0 +1,227 @@
+#include "strata/app/scene_runner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "strata/app/progress_bar.hpp"
+#include "strata/app/run_outputs.hpp"
+#include "strata/app/vtk_series.hpp"
+#include "strata/core/common/error.hpp"
+#include "strata/core/io/atomic_file.hpp"
+#include "strata/core/mesh/point_location.hpp"
+#include "strata/core/sim/simulation.hpp"
+
+namespace strata::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool is_explicit(const SolverSettings& settings) {
+  return settings.mode == SimulationMode::dynamic &&
+         settings.integrator != Integrator::implicit_euler;
+}
+
+/// Steps the run will take: ⌈duration/dt⌉ (dynamic, as Simulation::finished) or load_steps.
+long planned_steps(const SolverSettings& settings) {
+  if (settings.mode == SimulationMode::static_equilibrium) return settings.load_steps;
+  return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
+}
+
+/// Builds the Simulation; core InputErrors get the scene file as prefix.
+std::unique_ptr<Simulation> make_simulation(const Scene& scene, TetMesh mesh) {
+  try {
+    return std::make_unique<Simulation>(std::move(mesh), scene.material, scene.dirichlet_groups(),
+                                        scene.forces, scene.ground, scene.gravity, scene.solver);
+  } catch (const InputError& error) {
+    throw InputError(scene.file.string() + ": " + error.what());
+  }
+}
+
+nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
+                          const Simulation& simulation, const RunSummary& summary) {
+  const SimulationCounters counters = simulation.counters();
+  nlohmann::json stats;
+  stats["status"] = summary.status;
+  if (!summary.message.empty()) stats["message"] = summary.message;
+  stats["scene"] = scene.file.string();
+  stats["wall_seconds"] = summary.wall_seconds;
+  stats["steps"] = counters.steps;
+  stats["newton_iterations"] = counters.newton_iterations;
+  stats["element_evaluations"] = counters.element_evaluations;
+  stats["factorizations"] = counters.factorizations;
+  stats["vertices"] = simulation.mesh().vertices.rows();
+  stats["tets"] = simulation.mesh().tets.rows();
+  stats["dofs"] = 3 * simulation.mesh().vertices.rows();
+  Index constrained = 0;
+  std::vector<std::string> groups;
+  for (const DirichletGroup& group : simulation.dirichlet_groups()) {
+    constrained += 3 * static_cast<Index>(group.vertices.size());
+    groups.push_back(group.spec.name);
+  }
+  stats["free_dofs"] = 3 * simulation.mesh().vertices.rows() - constrained;
+  stats["groups"] = groups;
+  stats["mesh_source"] = prepared.source;
+  stats["reoriented_tets"] = prepared.reoriented_tets;
+  stats["removed_vertices"] = prepared.removed_vertices;
+  stats["material"] = {{"model", to_string(scene.material.model)},
+                       {"youngs_modulus", scene.material.youngs_modulus},
+                       {"poisson_ratio", scene.material.poisson_ratio},
+                       {"density", scene.material.density},
+                       {"mass_damping", scene.material.mass_damping},
+                       {"stiffness_damping", scene.material.stiffness_damping}};
+  stats["mode"] = to_string(scene.solver.mode);
+  if (scene.solver.mode == SimulationMode::dynamic) {
+    stats["integrator"] = to_string(scene.solver.integrator);
+    stats["dt"] = scene.solver.dt;
+    stats["duration"] = scene.solver.duration;
+    stats["final_time"] = simulation.time();
+  } else {
+    stats["load_steps"] = scene.solver.load_steps;
+    stats["final_load_factor"] = simulation.time();
+  }
+  stats["stable_dt_estimate"] = simulation.stable_dt_estimate();
+  const bool finite = simulation.positions().allFinite() && simulation.velocities().allFinite();
+  if (finite) {
+    stats["energies"] = {{"kinetic", simulation.kinetic_energy()},
+                         {"elastic", simulation.elastic_energy()},
+                         {"external_potential", simulation.external_potential_energy()}};
+    const VectorXd u = simulation.positions() - simulation.model().rest_positions();
+    double max_displacement = 0.0;
+    for (Index v = 0; v < u.size() / 3; ++v) {
+      max_displacement = std::max(max_displacement, u.segment<3>(3 * v).norm());
+    }
+    stats["max_displacement"] = max_displacement;
+  }
+  stats["frames"] = summary.frames;
+  stats["probes"] = scene.output.probes.size();
+  return stats;
+}
+
+void write_json(const std::filesystem::path& path, const nlohmann::json& value) {
+  write_file_atomically(path, [&value](std::ostream& out) { out << value.dump(2) << '\n'; });
+}
+
+}  // namespace
+
+RunSummary run_scene(const Scene& scene, const RunOptions& options) {
+  const Clock::time_point start = Clock::now();
+  std::ostream& log = options.log ? *options.log : std::cout;
+  RunSummary summary;
+  summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
+
+  PreparedMesh prepared = prepare_scene_mesh(scene);
+  const auto [lo, hi] = bounding_box(prepared.mesh.vertices);
+  const double diagonal = (hi - lo).norm();
+  const TetLocator locator(prepared.mesh.vertices, prepared.mesh.tets);
+  MatrixX3d probe_points(scene.output.probes.size(), 3);
+  for (std::size_t i = 0; i < scene.output.probes.size(); ++i) {
+    probe_points.row(i) = scene.output.probes[i].transpose();
+  }
+  std::vector<TetLocation> probe_locations;
+  try {
+    probe_locations =
+        locate_points(locator, probe_points, kProbeToleranceFactor * diagonal, "output.probes");
+  } catch (const InputError& error) {
+    throw InputError(scene.file.string() + ": " + error.what());
+  }
+  std::unique_ptr<Simulation> simulation = make_simulation(scene, prepared.mesh);
+  summary.stable_dt_estimate = simulation->stable_dt_estimate();
+
+  if (!options.quiet) {
+    log << "strata: " << scene.file.string() << ": " << prepared.mesh.vertices.rows()
+        << " vertices, " << prepared.mesh.tets.rows() << " tets";
+    if (prepared.reoriented_tets > 0) log << " (" << prepared.reoriented_tets << " reoriented)";
+    if (prepared.removed_vertices > 0) {
+      log << " (" << prepared.removed_vertices << " unreferenced vertices removed)";
+    }
+    log << ", " << to_string(scene.material.model) << ", " << to_string(scene.solver.mode);
+    if (scene.solver.mode == SimulationMode::dynamic) {
+      log << " " << to_string(scene.solver.integrator) << ", dt " << scene.solver.dt << " s, "
+          << planned_steps(scene.solver) << " steps\n";
+    } else {
+      log << ", " << scene.solver.load_steps << " load steps\n";
+    }
+  }
+  if (is_explicit(scene.solver)) {
+    if (!options.quiet) {
+      log << "strata: stable dt estimate " << summary.stable_dt_estimate << " s\n";
+    }
+    if (scene.solver.dt > summary.stable_dt_estimate) {
+      log.flush();
+      std::cerr << "strata: warning: dt = " << scene.solver.dt << " s exceeds the stable estimate "
+                << summary.stable_dt_estimate << " s of " << to_string(scene.solver.integrator)
+                << "; the run will likely diverge\n";
+    }
+  }
+  log.flush();
+
+  std::filesystem::create_directories(summary.output_dir);
+  ProbeRecorder probes(summary.output_dir / "probes.csv", prepared.mesh, scene.output.probes,
+                       std::move(probe_locations));
+  ReactionRecorder reactions(summary.output_dir / "reactions.csv");
+  std::optional<VtkSeries> vtk;
+  if (scene.output.vtk) vtk.emplace(summary.output_dir, scene.name);
+
+  const auto write_frame = [&]() {
+    const double time = simulation->time();
+    probes.record(time, simulation->positions() - simulation->model().rest_positions());
+    reactions.record(time, simulation->reactions());
+    if (vtk) vtk->write_frame(time, *simulation);
+    ++summary.frames;
+  };
+  const auto save_tables = [&]() {
+    probes.csv().save();
+    reactions.csv().save();
+  };
+  const auto finish = [&]() {
+    summary.steps = simulation->step_count();
+    summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    write_json(summary.output_dir / "stats.json",
+               stats_json(scene, prepared, *simulation, summary));
+  };
+
+  write_frame();
+  save_tables();
+  const long total_steps = planned_steps(scene.solver);
+  ProgressBar progress(options.progress);
+  try {
+    while (!simulation->finished()) {
+      simulation->advance();
+      const long step = simulation->step_count();
+      if (step % scene.output.every == 0 || simulation->finished()) {
+        write_frame();
+        probes.csv().save_if_due();
+        reactions.csv().save_if_due();
+      }
+      const bool dynamic = scene.solver.mode == SimulationMode::dynamic;
+      char label[64];
+      std::snprintf(label, sizeof label, dynamic ? "t = %.4g s" : "load factor %.4g",
+                    simulation->time());
+      progress.update(static_cast<double>(step) / total_steps, label);
+    }
+  } catch (const DivergenceError& error) {
+    progress.clear();
+    summary.status = "diverged";
+    summary.message = error.what();
+    save_tables();
+    finish();
+    throw;
+  }
+  progress.clear();
+  save_tables();
+  finish();
+  if (!options.quiet) {
+    log << "strata: done: " << summary.steps << " steps, " << summary.frames << " frames in "
+        << format_duration(summary.wall_seconds) << "; output in " << summary.output_dir.string()
+        << "\n";
+  }
+  return summary;
+}
+
+}  // namespace strata::app

@@ -1,0 +1,50 @@
+#include "strata/app/vtk_series.hpp"
+
+#include <cstdio>
+#include <regex>
+
+#include "strata/core/io/vtu.hpp"
+
+namespace strata::app {
+namespace {
+
+/// Removes the frames of an older run and returns the .pvd path.
+std::filesystem::path prepare_series(const std::filesystem::path& folder, const std::string& stem) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error)) return folder / (stem + ".pvd");
+  const std::regex frame_name(
+      std::regex_replace(stem, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") + R"(_\d{6}\.vtu)");
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), frame_name)) {
+      std::filesystem::remove(entry.path(), error);
+    }
+  }
+  return folder / (stem + ".pvd");
+}
+
+}  // namespace
+
+VtkSeries::VtkSeries(const std::filesystem::path& folder, const std::string& stem)
+    : m_folder(folder), m_stem(stem), m_pvd(prepare_series(folder, stem)) {}
+
+void VtkSeries::write_frame(double time, const Simulation& simulation) {
+  const TetMesh& mesh = simulation.mesh();
+  const MatrixX3d positions = unflatten(simulation.positions());
+  const TetFields tet_fields = simulation.model().tet_fields(simulation.positions());
+  VtuFields fields;
+  fields.add_point_data("displacement", Eigen::MatrixXd(positions - mesh.vertices));
+  fields.add_point_data("velocity", Eigen::MatrixXd(unflatten(simulation.velocities())));
+  fields.add_cell_data("green_strain", Eigen::MatrixXd(tet_fields.green_strain));
+  fields.add_cell_data("stress", Eigen::MatrixXd(tet_fields.cauchy_stress));
+  fields.add_cell_data("von_mises", Eigen::MatrixXd(tet_fields.von_mises));
+  fields.add_cell_data("level", Eigen::MatrixXi(Eigen::MatrixXi::Zero(mesh.tets.rows(), 1)));
+
+  char name[32];
+  std::snprintf(name, sizeof name, "_%06d.vtu", m_frames);
+  const std::string file = m_stem + name;
+  write_vtu(m_folder / file, positions, mesh.tets, fields);
+  m_pvd.add_frame(time, file);
+  ++m_frames;
+}
+
+}  // namespace strata::app

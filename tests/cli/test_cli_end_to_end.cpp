@@ -1,0 +1,298 @@
+// End-to-end runs of the strata executable on tiny scenes: exit codes, output files and their
+// content against independent computations (weight, applied load, discrete free fall).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cli_test_utils.hpp"
+
+namespace strata::cli_test {
+namespace {
+
+using nlohmann::json;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+/// A 1 × 0.1 × 0.1 m bar of 10 × 1 × 1 cells (44 vertices, 60 tets) fixed at x = 0.
+json bar_scene() {
+  return json::parse(R"({
+    "mesh": {"box": {"min": [0, 0, 0], "max": [1, 0.1, 0.1], "cells": [10, 1, 1]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e9, "poisson_ratio": 0.3,
+                 "density": 1000},
+    "gravity": [0, 0, -9.81],
+    "fixed": [{"box": {"min": [0, 0, 0], "max": [0, 0.1, 0.1]}}],
+    "solver": {"mode": "static", "load_steps": 2},
+    "output": {"probes": [[0, 0, 0], [1, 0.05, 0.05]]}
+  })");
+}
+
+std::filesystem::path write_scene(const TempFolder& folder, const json& scene,
+                                  const std::string& name = "scene.json") {
+  const std::filesystem::path path = folder.path() / name;
+  write_text(path, scene.dump(2));
+  return path;
+}
+
+TEST(CliEndToEnd, StaticGravityReactionEqualsWeight) {
+  TempFolder folder;
+  write_scene(folder, bar_scene());
+  const CliResult result = run_strata("run scene.json --quiet", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::filesystem::path out = folder.path() / "out" / "scene";
+
+  const Csv reactions = read_csv(out / "reactions.csv");
+  EXPECT_EQ(reactions.header, "time,group,fx,fy,fz,mx,my,mz");
+  ASSERT_EQ(reactions.rows.size(), 3u);  // load factors 0, 0.5, 1; one group
+  const std::vector<double>& last = reactions.rows.back();
+  EXPECT_DOUBLE_EQ(last[0], 1.0);
+  EXPECT_EQ(last[1], 0.0);
+  const double weight = 1000.0 * 0.01 * 9.81;  // ρ V g [N]
+  EXPECT_NEAR(last[2], 0.0, 1e-6 * weight);
+  EXPECT_NEAR(last[3], 0.0, 1e-6 * weight);
+  EXPECT_NEAR(last[4], weight, 1e-6 * weight);
+  // Moment about the fixed face's centroid (0, 0.05, 0.05): the weight acts at x ≈ 0.5 m, so
+  // the support holds M_y = −0.5 W (deflection shifts the lever by ~δ²/L, negligible here).
+  EXPECT_NEAR(last[6], -0.5 * weight, 1e-4 * weight);
+  EXPECT_NEAR(last[5], 0.0, 1e-6 * weight);
+  EXPECT_NEAR(last[7], 0.0, 1e-6 * weight);
+  // Half the load at load factor 0.5; nothing at 0.
+  EXPECT_NEAR(reactions.rows[1][4], 0.5 * weight, 1e-6 * weight);
+  EXPECT_NEAR(reactions.rows[0][4], 0.0, 1e-9 * weight);
+
+  const Csv probes = read_csv(out / "probes.csv");
+  EXPECT_EQ(probes.header, "time,probe,x,y,z,ux,uy,uz");
+  ASSERT_EQ(probes.rows.size(), 6u);  // 3 frames × 2 probes
+  for (const std::vector<double>& row : probes.rows) {
+    ASSERT_EQ(row.size(), 8u);
+    if (row[1] == 0.0) {  // a fixed vertex
+      EXPECT_EQ(row[5], 0.0);
+      EXPECT_EQ(row[6], 0.0);
+      EXPECT_EQ(row[7], 0.0);
+    }
+  }
+  EXPECT_EQ(probes.rows[5][1], 1.0);
+  EXPECT_DOUBLE_EQ(probes.rows[5][2], 1.0);
+  // Tip deflection: downwards, below Euler–Bernoulli's qL⁴/(8EI) (tets are stiffer), and almost
+  // linear in the load at this tiny strain.
+  const double beam_theory = weight * 1.0 / (8.0 * 1e9 * std::pow(0.1, 4) / 12.0);
+  const double tip = probes.rows[5][7];
+  EXPECT_LT(tip, 0.0);
+  EXPECT_GT(tip, -1.1 * beam_theory);
+  EXPECT_NEAR(probes.rows[3][7], 0.5 * tip, 1e-3 * std::abs(tip));
+
+  const json stats = read_json(out / "stats.json");
+  EXPECT_EQ(stats["status"], "ok");
+  EXPECT_EQ(stats["steps"], 2);
+  EXPECT_EQ(stats["vertices"], 44);
+  EXPECT_EQ(stats["tets"], 60);
+  EXPECT_EQ(stats["dofs"], 132);
+  EXPECT_EQ(stats["reoriented_tets"], 0);
+  for (const char* key : {"wall_seconds", "newton_iterations", "element_evaluations",
+                          "stable_dt_estimate", "material", "energies"}) {
+    EXPECT_TRUE(stats.contains(key)) << key;
+  }
+  EXPECT_GT(stats["newton_iterations"].get<long>(), 0);
+  EXPECT_GT(stats["element_evaluations"].get<long long>(), 0);
+
+  EXPECT_TRUE(std::filesystem::exists(out / "scene.pvd"));
+  EXPECT_TRUE(std::filesystem::exists(out / "scene_000000.vtu"));
+  EXPECT_TRUE(std::filesystem::exists(out / "scene_000002.vtu"));
+  const std::string vtu = read_text(out / "scene_000002.vtu");
+  for (const char* field :
+       {"displacement", "velocity", "green_strain", "stress", "von_mises", "level"}) {
+    EXPECT_THAT(vtu, HasSubstr(std::string("Name=\"") + field + "\"")) << field;
+  }
+}
+
+TEST(CliEndToEnd, TipForceReactionAndOverrides) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene.erase("gravity");
+  scene["forces"] = json::parse(
+      R"([{"region": {"box": {"min": [1, 0, 0], "max": [1, 0.1, 0.1]}}, "total_force": [0, 0, 1]}])");
+  scene["output"]["vtk"] = false;
+  write_scene(folder, scene);
+  const CliResult result = run_strata(
+      "run scene.json --out results --quiet --set forces.0.total_force=[0,0,-100] "
+      "--set solver.load_steps=1 --set output.probes.1.2=0.1",
+      folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::filesystem::path out = folder.path() / "results";
+  const Csv reactions = read_csv(out / "reactions.csv");
+  ASSERT_EQ(reactions.rows.size(), 2u);
+  EXPECT_NEAR(reactions.rows[1][4], 100.0, 1e-6 * 100.0);
+  // Moment of the tip load about (0, 0.05, 0.05), lever (1 + u_x, 0, 0.05 + u_z) deformed.
+  EXPECT_NEAR(reactions.rows[1][6], -100.0, 1e-2);
+  const Csv probes = read_csv(out / "probes.csv");
+  EXPECT_DOUBLE_EQ(probes.rows.back()[4], 0.1);  // the overridden probe z
+  EXPECT_EQ(read_json(out / "stats.json")["steps"], 1);
+  EXPECT_FALSE(std::filesystem::exists(out / "scene.pvd"));
+}
+
+TEST(CliEndToEnd, PrescribedStretchReactionsBalance) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene.erase("gravity");
+  scene["prescribed"] = json::parse(
+      R"([{"region": {"plane": {"point": [1, 0, 0], "normal": [1, 0, 0]}},
+           "displacement": [0.001, 0, 0]}])");
+  scene["output"] = {{"vtk", false}};
+  write_scene(folder, scene);
+  const CliResult result = run_strata("run scene.json --quiet", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const Csv reactions = read_csv(folder.path() / "out" / "scene" / "reactions.csv");
+  ASSERT_EQ(reactions.rows.size(), 6u);  // 3 frames × (fixed.0, prescribed.0)
+  const std::vector<double>& fixed = reactions.rows[4];
+  const std::vector<double>& pulled = reactions.rows[5];
+  EXPECT_EQ(fixed[1], 0.0);
+  EXPECT_EQ(pulled[1], 1.0);
+  // No body force: the two supports' forces cancel. Pulling needs a force of the order of
+  // E A ε = 1e9 · 0.01 · 1e-3 = 1e4 N (more with the lateral constraint of the clamped ends).
+  EXPECT_NEAR(fixed[2] + pulled[2], 0.0, 1e-6 * std::abs(pulled[2]));
+  EXPECT_LT(pulled[2], -1e4);
+  EXPECT_GT(pulled[2], -2e4);
+}
+
+/// Free fall without supports: elastic forces stay zero, so every scheme reproduces its own
+/// discrete kinematics exactly.
+TEST(CliEndToEnd, DynamicFreeFallMatchesDiscreteKinematics) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene.erase("fixed");
+  scene["solver"] = json::parse(R"({"mode": "dynamic", "dt": 0.01, "duration": 0.1})");
+  scene["output"] = json::parse(R"({"every": 5, "probes": [[0.5, 0.05, 0.05]], "vtk": false})");
+  const double g = 9.81, h = 0.01;
+  const int n = 10;
+  for (const auto& [integrator, expected] :
+       {std::pair<std::string, double>{"implicit_euler", -g * h * h * n * (n + 1) / 2.0},
+        {"symplectic_euler", -g * h * h * n * (n + 1) / 2.0},
+        {"rk4", -0.5 * g * (n * h) * (n * h)}}) {
+    scene["solver"]["integrator"] = integrator;
+    write_scene(folder, scene);
+    const CliResult result = run_strata("run scene.json --quiet", folder.path());
+    ASSERT_EQ(result.exit_code, 0) << integrator << ": " << result.err;
+    const Csv probes = read_csv(folder.path() / "out" / "scene" / "probes.csv");
+    ASSERT_EQ(probes.rows.size(), 3u) << integrator;  // t = 0, 0.05, 0.1
+    EXPECT_NEAR(probes.rows[2][0], 0.1, 1e-12);
+    EXPECT_NEAR(probes.rows[2][7], expected, 1e-9) << integrator;
+    EXPECT_NEAR(probes.rows[2][5], 0.0, 1e-12) << integrator;
+    const json stats = read_json(folder.path() / "out" / "scene" / "stats.json");
+    EXPECT_EQ(stats["steps"], n);
+    EXPECT_EQ(stats["integrator"], integrator);
+  }
+}
+
+TEST(CliEndToEnd, ExplicitRunBeyondStableStepDivergesWithExitCode3) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene["material"]["youngs_modulus"] = 1e7;
+  scene["solver"] =
+      json::parse(R"({"mode": "dynamic", "integrator": "rk4", "dt": 0.01, "duration": 10})");
+  write_scene(folder, scene);
+  const CliResult result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 3) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("strata: warning: dt = 0.01 s exceeds the stable estimate"));
+  EXPECT_THAT(result.err, HasSubstr("strata: error: "));
+  EXPECT_THAT(result.out, HasSubstr("stable dt estimate"));
+  const std::filesystem::path out = folder.path() / "out" / "scene";
+  const json stats = read_json(out / "stats.json");
+  EXPECT_EQ(stats["status"], "diverged");
+  EXPECT_FALSE(stats["message"].get<std::string>().empty());
+  EXPECT_LT(stats["steps"].get<long>(), 1000);
+  EXPECT_GT(stats["dt"].get<double>(), stats["stable_dt_estimate"].get<double>());
+  const Csv probes = read_csv(out / "probes.csv");
+  EXPECT_EQ(probes.header, "time,probe,x,y,z,ux,uy,uz");
+  EXPECT_GE(probes.rows.size(), 2u);  // at least the t = 0 frame
+  EXPECT_EQ(read_csv(out / "reactions.csv").header, "time,group,fx,fy,fz,mx,my,mz");
+  EXPECT_TRUE(std::filesystem::exists(out / "scene.pvd"));
+  EXPECT_TRUE(std::filesystem::exists(out / "scene_000000.vtu"));
+}
+
+TEST(CliEndToEnd, BadInputExitsWith2AndOneLineErrors) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene["output"]["probs"] = json::array();
+  write_scene(folder, scene, "typo.json");
+  CliResult result = run_strata("run typo.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(result.err, "strata: error: typo.json: output.probs: unknown key\n");
+
+  result = run_strata("run missing.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, StartsWith("strata: error: missing.json"));
+
+  write_text(folder.path() / "broken.json", "{\"mesh\": [1, 2,\n}");
+  result = run_strata("run broken.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("broken.json: line 2, column 1"));
+
+  write_scene(folder, bar_scene());
+  result = run_strata("run scene.json --set material.youngs=3", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("--set material.youngs"));
+
+  result = run_strata("run scene.json --set output.probes.0=[5,5,5]", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("output.probes.0: point (5, 5, 5) lies outside the mesh"));
+
+  result = run_strata("run scene.json --set fixed.0.box.min=[3,3,3] --set fixed.0.box.max=[4,4,4]",
+                      folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("fixed.0"));
+
+  result = run_strata("run", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  result = run_strata("frobnicate", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+}
+
+TEST(CliEndToEnd, BadMeshFileIsNamed) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene["mesh"] = {{"file", "beam.msh"}};
+  write_scene(folder, scene);
+  write_text(folder.path() / "beam.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0\n");
+  CliResult result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("beam.msh"));
+  std::filesystem::remove(folder.path() / "beam.msh");
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("beam.msh"));
+}
+
+TEST(CliEndToEnd, InfoConvertAndHelp) {
+  TempFolder folder;
+  // One tet, gmsh 2.2, listed with negative orientation.
+  write_text(folder.path() / "tet.msh",
+             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n"
+             "4 0 0 1\n$EndNodes\n$Elements\n1\n1 4 0 1 3 2 4\n$EndElements\n");
+  CliResult result = run_strata("convert tet.msh tet.vtu", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(std::filesystem::exists(folder.path() / "tet.vtu"));
+  result = run_strata("info tet.vtu", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out, HasSubstr("tet.vtu"));
+  EXPECT_FALSE(result.out.empty());
+
+  write_scene(folder, bar_scene());
+  result = run_strata("info scene.json", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out, HasSubstr("44"));  // vertices of the box mesh
+
+  result = run_strata("info nothing.msh", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("nothing.msh"));
+
+  result = run_strata("--help", folder.path());
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_THAT(result.out, HasSubstr("run"));
+  result = run_strata("run --help", folder.path());
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_THAT(result.out, HasSubstr("--set"));
+}
+
+}  // namespace
+}  // namespace strata::cli_test
