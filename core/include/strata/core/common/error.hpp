@@ -40,7 +40,7 @@ namespace detail {
 }  // namespace strata
 
 /// Always-on invariant check; throws std::logic_error naming file:line (never aborts).
-#define STRATA_VERIFY(condition, message)                                          \
-  do {                                                                             \
+#define STRATA_VERIFY(condition, message)                                                         \
+  do {                                                                                            \
     if (!(condition)) ::strata::detail::verify_failed(#condition, (message), __FILE__, __LINE__); \
   } while (false)

@@ -3,9 +3,11 @@
 /// Eigen aliases used across strata.
 ///
 /// DOF layout (the only one in strata): a state vector of a mesh with #V vertices has 3·#V entries,
-/// vertex-major: (x0, y0, z0, x1, y1, z1, ...). `flatten` / `unflatten` convert between that and the
-/// #V × 3 matrices that meshes and file readers use.
+/// vertex-major: (x0, y0, z0, x1, y1, z1, ...). `flatten` / `unflatten` convert between that and
+/// the #V × 3 matrices that meshes and file readers use.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <Eigen/SparseCore>
 
 namespace strata {
@@ -34,14 +36,16 @@ using ConstRef = const Eigen::Ref<const T>&;
 /// #V × 3 positions → 3·#V vertex-major vector.
 inline VectorXd flatten(ConstRef<MatrixX3d> positions) {
   VectorXd flat(3 * positions.rows());
-  for (Index v = 0; v < positions.rows(); ++v) flat.segment<3>(3 * v) = positions.row(v).transpose();
+  for (Index v = 0; v < positions.rows(); ++v)
+    flat.segment<3>(3 * v) = positions.row(v).transpose();
   return flat;
 }
 
 /// 3·#V vertex-major vector → #V × 3 positions.
 inline MatrixX3d unflatten(ConstRef<VectorXd> flat) {
   MatrixX3d positions(flat.size() / 3, 3);
-  for (Index v = 0; v < positions.rows(); ++v) positions.row(v) = flat.segment<3>(3 * v).transpose();
+  for (Index v = 0; v < positions.rows(); ++v)
+    positions.row(v) = flat.segment<3>(3 * v).transpose();
   return positions;
 }
 

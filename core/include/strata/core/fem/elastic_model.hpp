@@ -10,13 +10,14 @@
 
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/material.hpp"
+#include "strata/core/fem/tet_partition.hpp"
 #include "strata/core/fem/tet_rest_data.hpp"
 
 namespace strata {
 
 /// Per-tet stress and strain measures for output.
 struct TetFields {
-  Eigen::Matrix<double, Eigen::Dynamic, 6> green_strain;  ///< #T × 6 Voigt [xx yy zz xy yz xz]
+  Eigen::Matrix<double, Eigen::Dynamic, 6> green_strain;   ///< #T × 6 Voigt [xx yy zz xy yz xz]
   Eigen::Matrix<double, Eigen::Dynamic, 6> cauchy_stress;  ///< #T × 6 Voigt [Pa]
   VectorXd von_mises;                                      ///< #T [Pa]
 };
@@ -58,6 +59,9 @@ class ElasticModel {
   long long element_evaluations() const { return m_element_evaluations.load(); }
 
  private:
+  template <typename Kernel>
+  void accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
+                         double* energy) const;
   void build_stiffness_pattern();
 
   Index m_num_vertices;
@@ -66,9 +70,14 @@ class ElasticModel {
   LameParameters m_lame;
   TetRestData m_rest;
   VectorXd m_rest_positions;
+  /// Parallel schedule; the arrays below are in its sorted tet order.
+  TetPartition m_partition;
+  std::vector<int> m_sorted_tets;       ///< 4 per tet
+  std::vector<double> m_sorted_Dm_inv;  ///< 9 per tet, column-major
+  std::vector<double> m_sorted_volume;  ///< 1 per tet
   SparseMatrixd m_pattern;
-  /// For tet t, vertex pair (a, b) and column c = 0..2: offset in K's value array of the entry
-  /// (3·v_a, 3·v_b + c); the entries for rows 3·v_a+1, 3·v_a+2 follow it. 48 per tet.
+  /// For sorted tet i, vertex pair (a, b) and column c: offset in K's value array of the entry
+  /// (3·v_a, 3·v_b + c); rows 3·v_a + 1 and 3·v_a + 2 follow it. 48 per tet.
   std::vector<int> m_block_offsets;
   mutable std::atomic<long long> m_element_evaluations{0};
 };

@@ -33,10 +33,10 @@ LameParameters lame_parameters(double youngs_modulus, double poisson_ratio);
 /// A material: model, elastic constants, density and Rayleigh damping.
 struct Material {
   MaterialModel model = MaterialModel::stvk;
-  double youngs_modulus = 1e6;  ///< E [Pa]
-  double poisson_ratio = 0.3;   ///< ν, dimensionless, in [0, 0.5)
-  double density = 1000.0;      ///< ρ [kg/m³]
-  double mass_damping = 0.0;    ///< Rayleigh α [1/s]: damping force −α M v
+  double youngs_modulus = 1e6;     ///< E [Pa]
+  double poisson_ratio = 0.3;      ///< ν, dimensionless, in [0, 0.5)
+  double density = 1000.0;         ///< ρ [kg/m³]
+  double mass_damping = 0.0;       ///< Rayleigh α [1/s]: damping force −α M v
   double stiffness_damping = 0.0;  ///< Rayleigh β [s]: damping force −β K v
 
   LameParameters lame() const { return lame_parameters(youngs_modulus, poisson_ratio); }

@@ -1,0 +1,287 @@
+#include "strata/core/fem/elastic_model.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/fem/deformation_gradient.hpp"
+#include "strata/core/fem/green_strain.hpp"
+#include "strata/core/fem/hyperelastic.hpp"
+#include "strata/core/fem/isotropic_stress.hpp"
+#include "strata/core/fem/psd_projection.hpp"
+
+namespace strata {
+
+namespace {
+
+// Element kernels: first Piola stress (and energy density) of one model, inlined in the loops.
+struct StvkKernel {
+  LameParameters lame;
+  Matrix3d P(const Matrix3d& F) const { return dpsi_stvk_dF(F, lame); }
+  double psi(const Matrix3d& F) const { return psi_stvk(F, lame); }
+};
+struct CorotatedKernel {
+  LameParameters lame;
+  Matrix3d P(const Matrix3d& F) const { return dpsi_corotated_dF(F, lame); }
+  double psi(const Matrix3d& F) const { return psi_corotated(F, lame); }
+};
+struct NeoHookeanKernel {
+  LameParameters lame;
+  Matrix3d P(const Matrix3d& F) const { return dpsi_neohookean_dF(F, lame); }
+  double psi(const Matrix3d& F) const { return psi_neohookean(F, lame); }
+};
+
+template <typename Body>
+void dispatch_kernel(MaterialModel model, const LameParameters& lame, Body&& body) {
+  switch (model) {
+    case MaterialModel::stvk:
+      return body(StvkKernel{lame});
+    case MaterialModel::corotated:
+      return body(CorotatedKernel{lame});
+    case MaterialModel::neohookean:
+      return body(NeoHookeanKernel{lame});
+  }
+}
+
+inline Matrix3d edge_matrix_at(const double* x, const int* tet) {
+  const Eigen::Map<const Vector3d> x0(x + 3 * tet[0]);
+  Matrix3d Ds;
+  Ds.col(0) = Eigen::Map<const Vector3d>(x + 3 * tet[1]) - x0;
+  Ds.col(1) = Eigen::Map<const Vector3d>(x + 3 * tet[2]) - x0;
+  Ds.col(2) = Eigen::Map<const Vector3d>(x + 3 * tet[3]) - x0;
+  return Ds;
+}
+
+void check_size(ConstRef<VectorXd> x, Index num_dofs) {
+  if (x.size() != num_dofs)
+    throw std::invalid_argument("ElasticModel: position vector has " + std::to_string(x.size()) +
+                                " entries, expected " + std::to_string(num_dofs));
+}
+
+}  // namespace
+
+ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4i> tets,
+                           const Material& material)
+    : m_num_vertices(rest_positions.rows()),
+      m_tets(tets),
+      m_material(material),
+      m_lame(material.lame()),
+      m_rest(compute_tet_rest_data(rest_positions, tets)),
+      m_rest_positions(flatten(rest_positions)) {
+  validate_material(material, "material");
+  m_partition = build_tet_partition(rest_positions, tets);
+  const Index num_tets = tets.rows();
+  m_sorted_tets.resize(4 * num_tets);
+  m_sorted_Dm_inv.resize(9 * num_tets);
+  m_sorted_volume.resize(num_tets);
+  for (Index i = 0; i < num_tets; ++i) {
+    const int t = m_partition.order[i];
+    for (int k = 0; k < 4; ++k)
+      m_sorted_tets[4 * i + k] = tets(t, k);
+    Eigen::Map<Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
+    Dm_inv = m_rest.Dm_inv[t];
+    m_sorted_volume[i] = m_rest.rest_volume[t];
+  }
+  build_stiffness_pattern();
+}
+
+template <typename Kernel>
+void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
+                                     double* energy) const {
+  std::vector<double> chunk_energy(energy ? m_partition.num_chunks() : 0, 0.0);
+  const double* positions = x.data();
+  double* forces = f.data();
+  for_each_chunk_colored(m_partition, [&](int chunk) {
+    double sum = 0.0;
+    for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
+      const int* tet = &m_sorted_tets[4 * i];
+      const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
+      const Matrix3d F = edge_matrix_at(positions, tet) * Dm_inv;
+      // Forces on vertices 1..3 are the columns of −V P Dm⁻ᵀ; vertex 0 balances them.
+      const Matrix3d H = -m_sorted_volume[i] * kernel.P(F) * Dm_inv.transpose();
+      if (energy) sum += m_sorted_volume[i] * kernel.psi(F);
+      for (int k = 0; k < 3; ++k)
+        Eigen::Map<Vector3d>(forces + 3 * tet[k + 1]) += H.col(k);
+      Eigen::Map<Vector3d>(forces + 3 * tet[0]) -= H.rowwise().sum();
+    }
+    if (energy) chunk_energy[chunk] = sum;
+  });
+  if (energy) {
+    *energy = 0.0;
+    for (double e : chunk_energy)
+      *energy += e;
+  }
+  m_element_evaluations += num_tets();
+}
+
+double ElasticModel::energy(ConstRef<VectorXd> x) const {
+  check_size(x, num_dofs());
+  std::vector<double> chunk_energy(m_partition.num_chunks(), 0.0);
+  dispatch_kernel(m_material.model, m_lame, [&](const auto& kernel) {
+    tbb::parallel_for(Index(0), m_partition.num_chunks(), [&](Index chunk) {
+      double sum = 0.0;
+      for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
+        const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
+        sum += m_sorted_volume[i] *
+               kernel.psi(edge_matrix_at(x.data(), &m_sorted_tets[4 * i]) * Dm_inv);
+      }
+      chunk_energy[chunk] = sum;
+    });
+  });
+  m_element_evaluations += num_tets();
+  double total = 0.0;
+  for (double e : chunk_energy)
+    total += e;
+  return total;
+}
+
+void ElasticModel::forces(ConstRef<VectorXd> x, VectorXd& f) const {
+  check_size(x, num_dofs());
+  f.setZero(num_dofs());
+  dispatch_kernel(m_material.model, m_lame,
+                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, nullptr); });
+}
+
+double ElasticModel::energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const {
+  check_size(x, num_dofs());
+  f.setZero(num_dofs());
+  double energy = 0.0;
+  dispatch_kernel(m_material.model, m_lame,
+                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, &energy); });
+  return energy;
+}
+
+void ElasticModel::build_stiffness_pattern() {
+  const Index num_tets = m_tets.rows();
+  // Vertex adjacency (including self), as sorted unique neighbour lists per column vertex.
+  std::vector<std::vector<int>> neighbours(m_num_vertices);
+  for (Index t = 0; t < num_tets; ++t)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        neighbours[m_tets(t, b)].push_back(m_tets(t, a));
+  std::vector<int> outer(3 * m_num_vertices + 1, 0);
+  Index nnz = 0;
+  for (Index v = 0; v < m_num_vertices; ++v) {
+    auto& list = neighbours[v];
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    for (int c = 0; c < 3; ++c) {
+      outer[3 * v + c] = static_cast<int>(nnz);
+      nnz += 3 * static_cast<Index>(list.size());
+    }
+  }
+  outer[3 * m_num_vertices] = static_cast<int>(nnz);
+  if (nnz > std::numeric_limits<int>::max())
+    throw InputError("mesh too large: stiffness matrix exceeds 2^31 entries");
+
+  m_pattern.resize(num_dofs(), num_dofs());
+  m_pattern.resizeNonZeros(nnz);
+  std::copy(outer.begin(), outer.end(), m_pattern.outerIndexPtr());
+  for (Index v = 0; v < m_num_vertices; ++v)
+    for (int c = 0; c < 3; ++c) {
+      int position = outer[3 * v + c];
+      for (int row_vertex : neighbours[v])
+        for (int r = 0; r < 3; ++r)
+          m_pattern.innerIndexPtr()[position++] = 3 * row_vertex + r;
+    }
+  std::fill(m_pattern.valuePtr(), m_pattern.valuePtr() + nnz, 0.0);
+
+  m_block_offsets.resize(48 * num_tets);
+  for (Index i = 0; i < num_tets; ++i) {
+    const int* tet = &m_sorted_tets[4 * i];
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        const auto& list = neighbours[tet[b]];
+        const int slot =
+            static_cast<int>(std::lower_bound(list.begin(), list.end(), tet[a]) - list.begin());
+        for (int c = 0; c < 3; ++c)
+          m_block_offsets[48 * i + 12 * a + 3 * b + c] = outer[3 * tet[b] + c] + 3 * slot;
+      }
+  }
+}
+
+void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const {
+  check_size(x, num_dofs());
+  if (K.rows() != m_pattern.rows() || K.nonZeros() != m_pattern.nonZeros() ||
+      !std::equal(m_pattern.outerIndexPtr(), m_pattern.outerIndexPtr() + m_pattern.outerSize() + 1,
+                  K.outerIndexPtr()))
+    K = m_pattern;
+  else
+    std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
+  double* values = K.valuePtr();
+  for_each_chunk_colored(m_partition, [&](int chunk) {
+    for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
+      const int* tet = &m_sorted_tets[4 * i];
+      const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
+      const Matrix3d F = edge_matrix_at(x.data(), tet) * Dm_inv;
+      Matrix9d d2psi = d2psi_dF2(m_material.model, F, m_lame);
+      if (project_psd) d2psi = project_to_psd<9>(d2psi);
+      // K_ab = V Σ_{c,d} ∇N_a[c] ∇N_b[d] · (∂²ψ/∂F_{·c}∂F_{·d}) as 3 × 3 blocks.
+      const Eigen::Matrix<double, 4, 3> grad_N = shape_function_gradients(Dm_inv);
+      const double volume = m_sorted_volume[i];
+      Eigen::Matrix<double, 9, 12> right;  // d2psi · ∂F/∂x, column block b: Σ_d d2psi(:, d) ∇N_b[d]
+      for (int b = 0; b < 4; ++b)
+        for (int r = 0; r < 3; ++r) {
+          Vector9d column = Vector9d::Zero();
+          for (int d = 0; d < 3; ++d)
+            column += grad_N(b, d) * d2psi.col(3 * d + r);
+          right.col(3 * b + r) = column;
+        }
+      const int* offsets = &m_block_offsets[48 * i];
+      for (int a = 0; a < 4; ++a) {
+        // rows of block a: Σ_c ∇N_a[c] right(3c + r', :)
+        Eigen::Matrix<double, 3, 12> rows = Eigen::Matrix<double, 3, 12>::Zero();
+        for (int c = 0; c < 3; ++c)
+          rows += grad_N(a, c) * right.middleRows<3>(3 * c);
+        rows *= volume;
+        for (int b = 0; b < 4; ++b)
+          for (int c = 0; c < 3; ++c) {
+            double* entry = values + offsets[12 * a + 3 * b + c];
+            entry[0] += rows(0, 3 * b + c);
+            entry[1] += rows(1, 3 * b + c);
+            entry[2] += rows(2, 3 * b + c);
+          }
+      }
+    }
+  });
+  m_element_evaluations += num_tets();
+}
+
+std::pair<double, Index> ElasticModel::min_volume_ratio(ConstRef<VectorXd> x) const {
+  check_size(x, num_dofs());
+  double min_J = std::numeric_limits<double>::infinity();
+  Index min_tet = -1;
+  for (Index t = 0; t < num_tets(); ++t) {
+    int tet[4] = {m_tets(t, 0), m_tets(t, 1), m_tets(t, 2), m_tets(t, 3)};
+    const double J = (edge_matrix_at(x.data(), tet) * m_rest.Dm_inv[t]).determinant();
+    if (J < min_J || std::isnan(J)) {
+      min_J = J;
+      min_tet = t;
+      if (std::isnan(J)) break;
+    }
+  }
+  return {min_J, min_tet};
+}
+
+TetFields ElasticModel::tet_fields(ConstRef<VectorXd> x) const {
+  check_size(x, num_dofs());
+  TetFields fields;
+  fields.green_strain.resize(num_tets(), 6);
+  fields.cauchy_stress.resize(num_tets(), 6);
+  fields.von_mises.resize(num_tets());
+  tbb::parallel_for(Index(0), num_tets(), [&](Index t) {
+    int tet[4] = {m_tets(t, 0), m_tets(t, 1), m_tets(t, 2), m_tets(t, 3)};
+    const Matrix3d F = edge_matrix_at(x.data(), tet) * m_rest.Dm_inv[t];
+    const Matrix3d sigma = cauchy_stress(dpsi_dF(m_material.model, F, m_lame), F);
+    fields.green_strain.row(t) = to_voigt(green_strain(F)).transpose();
+    fields.cauchy_stress.row(t) = to_voigt(sigma).transpose();
+    fields.von_mises[t] = von_mises_stress(sigma);
+  });
+  return fields;
+}
+
+}  // namespace strata

@@ -1,0 +1,189 @@
+#include "strata/core/mesh/tet_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+namespace {
+
+Vector3d vertex(const TetMesh& mesh, int index) {
+  return mesh.vertices.row(index).transpose();
+}
+
+}  // namespace
+
+double tet_signed_volume(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2,
+                         const Vector3d& x3) {
+  return (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+}
+
+double tet_normalized_volume(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2,
+                             const Vector3d& x3) {
+  const double longest_edge = std::sqrt(
+      std::max({(x1 - x0).squaredNorm(), (x2 - x0).squaredNorm(), (x3 - x0).squaredNorm(),
+                (x2 - x1).squaredNorm(), (x3 - x1).squaredNorm(), (x3 - x2).squaredNorm()}));
+  if (!(longest_edge > 0.0)) return 0.0;
+  return 6.0 * std::sqrt(2.0) * tet_signed_volume(x0, x1, x2, x3) / std::pow(longest_edge, 3);
+}
+
+void validate_tet_mesh(const TetMesh& mesh, const std::string& source) {
+  const Index num_vertices = mesh.vertices.rows();
+  if (mesh.tets.rows() == 0) throw InputError(source + ": mesh has no tetrahedra");
+  for (Index v = 0; v < num_vertices; ++v) {
+    if (!mesh.vertices.row(v).allFinite())
+      throw InputError(source + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
+  }
+  for (Index t = 0; t < mesh.tets.rows(); ++t) {
+    for (int k = 0; k < 4; ++k) {
+      const int index = mesh.tets(t, k);
+      if (index < 0 || index >= num_vertices)
+        throw InputError(source + ": tet " + std::to_string(t) + " references vertex " +
+                         std::to_string(index) + " (mesh has " + std::to_string(num_vertices) +
+                         " vertices)");
+      for (int j = 0; j < k; ++j) {
+        if (mesh.tets(t, j) == index)
+          throw InputError(source + ": tet " + std::to_string(t) + " repeats vertex " +
+                           std::to_string(index));
+      }
+    }
+    const double quality =
+        tet_normalized_volume(vertex(mesh, mesh.tets(t, 0)), vertex(mesh, mesh.tets(t, 1)),
+                              vertex(mesh, mesh.tets(t, 2)), vertex(mesh, mesh.tets(t, 3)));
+    if (!(std::abs(quality) >= kDegenerateTetThreshold))
+      throw InputError(source + ": tet " + std::to_string(t) +
+                       " is degenerate (volume relative to its longest edge cubed: " +
+                       std::to_string(quality) + ")");
+  }
+}
+
+Index orient_tets(TetMesh& mesh) {
+  Index flipped = 0;
+  for (Index t = 0; t < mesh.tets.rows(); ++t) {
+    const double volume =
+        tet_signed_volume(vertex(mesh, mesh.tets(t, 0)), vertex(mesh, mesh.tets(t, 1)),
+                          vertex(mesh, mesh.tets(t, 2)), vertex(mesh, mesh.tets(t, 3)));
+    if (volume < 0.0) {
+      std::swap(mesh.tets(t, 2), mesh.tets(t, 3));
+      ++flipped;
+    }
+  }
+  return flipped;
+}
+
+Index remove_unreferenced_vertices(TetMesh& mesh) {
+  std::vector<int> new_index(mesh.vertices.rows(), -1);
+  int count = 0;
+  for (Index t = 0; t < mesh.tets.rows(); ++t)
+    for (int k = 0; k < 4; ++k)
+      if (new_index[mesh.tets(t, k)] < 0) new_index[mesh.tets(t, k)] = 0;
+  for (auto& index : new_index)
+    if (index == 0) index = count++;
+  const Index removed = mesh.vertices.rows() - count;
+  if (removed == 0) return 0;
+  MatrixX3d vertices(count, 3);
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    if (new_index[v] >= 0) vertices.row(new_index[v]) = mesh.vertices.row(v);
+  for (Index t = 0; t < mesh.tets.rows(); ++t)
+    for (int k = 0; k < 4; ++k)
+      mesh.tets(t, k) = new_index[mesh.tets(t, k)];
+  mesh.vertices = std::move(vertices);
+  return removed;
+}
+
+MatrixX3i boundary_faces(const MatrixX4i& tets) {
+  // Outward faces of a positively oriented tet (0, 1, 2, 3).
+  static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  struct Face {
+    std::array<int, 3> key;
+    std::array<int, 3> oriented;
+  };
+  std::vector<Face> faces;
+  faces.reserve(4 * tets.rows());
+  for (Index t = 0; t < tets.rows(); ++t) {
+    for (const auto& local : kFaces) {
+      Face face;
+      face.oriented = {tets(t, local[0]), tets(t, local[1]), tets(t, local[2])};
+      face.key = face.oriented;
+      std::sort(face.key.begin(), face.key.end());
+      faces.push_back(face);
+    }
+  }
+  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.key < b.key; });
+  std::vector<std::array<int, 3>> boundary;
+  for (std::size_t i = 0; i < faces.size();) {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key)
+      ++j;
+    if (j - i == 1) boundary.push_back(faces[i].oriented);
+    i = j;
+  }
+  MatrixX3i result(boundary.size(), 3);
+  for (std::size_t f = 0; f < boundary.size(); ++f)
+    result.row(f) << boundary[f][0], boundary[f][1], boundary[f][2];
+  return result;
+}
+
+std::pair<Vector3d, Vector3d> bounding_box(ConstRef<MatrixX3d> points) {
+  if (points.rows() == 0) return {Vector3d::Zero(), Vector3d::Zero()};
+  return {points.colwise().minCoeff().transpose(), points.colwise().maxCoeff().transpose()};
+}
+
+double mesh_volume(const TetMesh& mesh) {
+  double volume = 0.0;
+  for (Index t = 0; t < mesh.tets.rows(); ++t)
+    volume += tet_signed_volume(vertex(mesh, mesh.tets(t, 0)), vertex(mesh, mesh.tets(t, 1)),
+                                vertex(mesh, mesh.tets(t, 2)), vertex(mesh, mesh.tets(t, 3)));
+  return volume;
+}
+
+TetMesh box_tet_mesh(const Vector3d& min, const Vector3d& max, const std::array<int, 3>& cells) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (cells[axis] < 1)
+      throw InputError("box mesh: cells[" + std::to_string(axis) + "] must be >= 1");
+    if (!(max[axis] > min[axis]))
+      throw InputError("box mesh: max[" + std::to_string(axis) + "] must exceed min[" +
+                       std::to_string(axis) + "]");
+  }
+  const int nx = cells[0] + 1, ny = cells[1] + 1, nz = cells[2] + 1;
+  const auto index = [&](int i, int j, int k) { return i + nx * (j + ny * k); };
+  TetMesh mesh;
+  mesh.vertices.resize(static_cast<Index>(nx) * ny * nz, 3);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const Vector3d t(double(i) / cells[0], double(j) / cells[1], double(k) / cells[2]);
+        mesh.vertices.row(index(i, j, k)) =
+            (min.array() + t.array() * (max - min).array()).matrix();
+      }
+  // Kuhn split: six tets along paths 000 → e_a → e_a + e_b → 111 over the axis permutations.
+  static constexpr int kPermutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                              {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  mesh.tets.resize(6 * static_cast<Index>(cells[0]) * cells[1] * cells[2], 4);
+  Index t = 0;
+  for (int k = 0; k < cells[2]; ++k)
+    for (int j = 0; j < cells[1]; ++j)
+      for (int i = 0; i < cells[0]; ++i)
+        for (const auto& permutation : kPermutations) {
+          std::array<int, 3> corner = {i, j, k};
+          int tet[4];
+          tet[0] = index(corner[0], corner[1], corner[2]);
+          for (int step = 0; step < 3; ++step) {
+            ++corner[permutation[step]];
+            tet[step + 1] = index(corner[0], corner[1], corner[2]);
+          }
+          // Odd permutations give negatively oriented paths: swap to keep all positive.
+          const bool odd = (permutation[0] == 0 && permutation[1] == 2) ||
+                           (permutation[0] == 1 && permutation[1] == 0) ||
+                           (permutation[0] == 2 && permutation[1] == 1);
+          if (odd) std::swap(tet[2], tet[3]);
+          mesh.tets.row(t++) << tet[0], tet[1], tet[2], tet[3];
+        }
+  return mesh;
+}
+
+}  // namespace strata
