@@ -4,6 +4,7 @@
 /// Format: https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html
 #include <filesystem>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -22,17 +23,21 @@ struct VtuFields {
   std::vector<std::pair<std::string, Eigen::MatrixXd>> cell_data;       ///< e.g. "stress" #T × 6
   std::vector<std::pair<std::string, Eigen::MatrixXi>> cell_int_data;   ///< e.g. "level" #T × 1
 
-  void add_point_data(std::string name, Eigen::MatrixXd values) {
-    point_data.emplace_back(std::move(name), std::move(values));
+  /// Adds a #V × k point field; integer matrices become Int32 arrays, others Float64.
+  template <typename Derived>
+  void add_point_data(std::string name, const Eigen::MatrixBase<Derived>& values) {
+    if constexpr (std::is_integral_v<typename Derived::Scalar>)
+      point_int_data.emplace_back(std::move(name), values.template cast<int>());
+    else
+      point_data.emplace_back(std::move(name), values.template cast<double>());
   }
-  void add_point_data(std::string name, Eigen::MatrixXi values) {
-    point_int_data.emplace_back(std::move(name), std::move(values));
-  }
-  void add_cell_data(std::string name, Eigen::MatrixXd values) {
-    cell_data.emplace_back(std::move(name), std::move(values));
-  }
-  void add_cell_data(std::string name, Eigen::MatrixXi values) {
-    cell_int_data.emplace_back(std::move(name), std::move(values));
+  /// Adds a #T × k cell field; integer matrices become Int32 arrays, others Float64.
+  template <typename Derived>
+  void add_cell_data(std::string name, const Eigen::MatrixBase<Derived>& values) {
+    if constexpr (std::is_integral_v<typename Derived::Scalar>)
+      cell_int_data.emplace_back(std::move(name), values.template cast<int>());
+    else
+      cell_data.emplace_back(std::move(name), values.template cast<double>());
   }
 };
 

@@ -1,0 +1,116 @@
+// VTU frames with fields and ParaView .pvd series.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/io/pvd.hpp"
+#include "strata/core/io/vtu.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+
+namespace strata {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& tag)
+      : m_path(fs::temp_directory_path() / ("strata_" + tag + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(m_path);
+    fs::create_directories(m_path);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(m_path, ignored);
+  }
+  fs::path operator/(const std::string& name) const { return m_path / name; }
+
+ private:
+  fs::path m_path;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream content;
+  content << in.rdbuf();
+  return content.str();
+}
+
+int count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+    ++n;
+  return n;
+}
+
+TEST(IoVtuFrames, FrameWithFieldsReadsBackDeformedPositions) {
+  ScratchDir dir("io_frame");
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {2, 1, 1});
+  MatrixX3d displacement = MatrixX3d::Zero(mesh.vertices.rows(), 3);
+  displacement.col(2) = 0.1 * mesh.vertices.col(0);
+  const MatrixX3d positions = mesh.vertices + displacement;
+  VtuFields fields;
+  fields.add_point_data("displacement", displacement);
+  fields.add_cell_data("green_strain", Eigen::MatrixXd::Random(mesh.tets.rows(), 6));
+  fields.add_cell_data("level", Eigen::MatrixXi::Zero(mesh.tets.rows(), 1));
+  fields.add_point_data("a<b&\"c\"", Eigen::MatrixXd::Zero(mesh.vertices.rows(), 1));
+  write_vtu(dir / "f.vtu", positions, mesh.tets, fields);
+
+  const TetMesh back = read_vtu(dir / "f.vtu");
+  EXPECT_TRUE((back.vertices.array() == positions.array()).all());
+  EXPECT_TRUE((back.tets.array() == mesh.tets.array()).all());
+  const std::string text = read_text(dir / "f.vtu");
+  EXPECT_EQ(count(text, "Name=\"displacement\" NumberOfComponents=\"3\""), 1);
+  EXPECT_EQ(count(text, "type=\"Float64\" Name=\"green_strain\" NumberOfComponents=\"6\""), 1);
+  EXPECT_EQ(count(text, "type=\"Int32\" Name=\"level\" NumberOfComponents=\"1\""), 1);
+  EXPECT_EQ(count(text, "Name=\"a&lt;b&amp;&quot;c&quot;\""), 1);
+}
+
+TEST(IoVtuFrames, FieldWithWrongRowCountIsInputErrorNamingIt) {
+  ScratchDir dir("io_frame_rows");
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {1, 1, 1});
+  VtuFields fields;
+  fields.add_point_data("velocity", Eigen::MatrixXd::Zero(mesh.vertices.rows() + 1, 3));
+  try {
+    write_vtu(dir / "f.vtu", mesh.vertices, mesh.tets, fields);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("velocity"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("f.vtu"), std::string::npos);
+  }
+  EXPECT_FALSE(fs::exists(dir / "f.vtu"));
+}
+
+TEST(IoVtuFrames, PvdIsValidAfterEveryFrame) {
+  ScratchDir dir("io_pvd");
+  const fs::path pvd = dir / "run.pvd";
+  PvdWriter writer(pvd);
+  std::string text = read_text(pvd);
+  EXPECT_EQ(count(text, "<DataSet"), 0);
+  EXPECT_EQ(count(text, "</VTKFile>"), 1);
+  for (int frame = 0; frame < 3; ++frame) {
+    writer.add_frame(0.5 * frame, "frames/frame_" + std::to_string(frame) + ".vtu");
+    text = read_text(pvd);
+    EXPECT_EQ(count(text, "<DataSet"), frame + 1);
+    EXPECT_EQ(count(text, "</VTKFile>"), 1);
+    EXPECT_EQ(count(text, "file=\"frames/frame_" + std::to_string(frame) + ".vtu\""), 1);
+  }
+  writer.add_frame(1.0, "frames/surface_2.vtp", 1);
+  text = read_text(pvd);
+  EXPECT_EQ(count(text, "timestep=\"1\" group=\"\" part=\"1\" file=\"frames/surface_2.vtp\""), 1);
+  EXPECT_EQ(count(text, "timestep=\"0.5\" group=\"\" part=\"0\""), 1);
+  EXPECT_EQ(writer.entries().size(), 4u);
+}
+
+TEST(IoVtuFrames, PvdInMissingFolderIsInputError) {
+  ScratchDir dir("io_pvd_missing");
+  EXPECT_THROW(PvdWriter(dir / "nope" / "run.pvd"), InputError);
+}
+
+}  // namespace
+}  // namespace strata
