@@ -7,12 +7,14 @@
 #include <limits>
 #include <string>
 
+#include "batched_stress_kernels.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/fem/deformation_gradient.hpp"
 #include "strata/core/fem/green_strain.hpp"
 #include "strata/core/fem/hyperelastic.hpp"
 #include "strata/core/fem/isotropic_stress.hpp"
 #include "strata/core/fem/psd_projection.hpp"
+#include "strata/core/fem/stvk.hpp"
 
 namespace strata {
 
@@ -20,6 +22,7 @@ namespace {
 
 // Element kernels: first Piola stress (and energy density) of one model, inlined in the loops.
 struct StvkKernel {
+  using LaneKernel = detail::StvkLanes;
   LameParameters lame;
   Matrix3d P(const Matrix3d& F) const { return dpsi_stvk_dF(F, lame); }
   double psi(const Matrix3d& F) const { return psi_stvk(F, lame); }
@@ -30,6 +33,7 @@ struct CorotatedKernel {
   double psi(const Matrix3d& F) const { return psi_corotated(F, lame); }
 };
 struct NeoHookeanKernel {
+  using LaneKernel = detail::NeoHookeanLanes;
   LameParameters lame;
   Matrix3d P(const Matrix3d& F) const { return dpsi_neohookean_dF(F, lame); }
   double psi(const Matrix3d& F) const { return psi_neohookean(F, lame); }
@@ -86,8 +90,69 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
     Dm_inv = m_rest.Dm_inv[t];
     m_sorted_volume[i] = m_rest.rest_volume[t];
   }
+  // Dm⁻¹ regrouped for the vectorised kernels: lane group g holds entry (j, c) of its kLanes tets
+  // at [g · 9 · kLanes + (3c + j) · kLanes + lane].
+  const Index num_groups = (num_tets + detail::kLanes - 1) / detail::kLanes;
+  m_lane_Dm_inv.assign(9 * detail::kLanes * num_groups, 0.0);
+  for (Index i = 0; i < num_tets; ++i)
+    for (int entry = 0; entry < 9; ++entry)
+      m_lane_Dm_inv[9 * detail::kLanes * (i / detail::kLanes) + entry * detail::kLanes +
+                    i % detail::kLanes] = m_sorted_Dm_inv[9 * i + entry];
   build_stiffness_pattern();
 }
+
+namespace {
+
+/// Forces (and energies) of the sorted tets [first, first + kLanes), all lanes at once.
+template <bool kWithEnergy, typename LaneKernel>
+double lane_group_forces(const LaneKernel& kernel, const double* positions, const int* tets,
+                         const double* lane_Dm_inv, const double* volume, double* forces) {
+  using detail::kLanes;
+  double x[4][3][kLanes];
+  for (int l = 0; l < kLanes; ++l)
+    for (int k = 0; k < 4; ++k)
+      for (int r = 0; r < 3; ++r)
+        x[k][r][l] = positions[3 * tets[4 * l + k] + r];
+  double Ds[3][3][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 3; ++j)
+      for (int l = 0; l < kLanes; ++l)
+        Ds[r][j][l] = x[j + 1][r][l] - x[0][r][l];
+  // lane_Dm_inv[(3c + j) · kLanes + l] = Dm⁻¹(j, c) of lane l.
+  double F[3][3][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < kLanes; ++l)
+        F[r][c][l] = Ds[r][0][l] * lane_Dm_inv[(3 * c + 0) * kLanes + l] +
+                     Ds[r][1][l] * lane_Dm_inv[(3 * c + 1) * kLanes + l] +
+                     Ds[r][2][l] * lane_Dm_inv[(3 * c + 2) * kLanes + l];
+  double P[3][3][kLanes], psi[kLanes];
+  kernel.template operator()<kWithEnergy>(F, P, psi);
+  // H = −V P Dm⁻ᵀ: column j is the force on vertex j + 1.
+  double H[3][3][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 3; ++j)
+      for (int l = 0; l < kLanes; ++l)
+        H[r][j][l] = -volume[l] * (P[r][0][l] * lane_Dm_inv[(0 + j) * kLanes + l] +
+                                   P[r][1][l] * lane_Dm_inv[(3 + j) * kLanes + l] +
+                                   P[r][2][l] * lane_Dm_inv[(6 + j) * kLanes + l]);
+  for (int l = 0; l < kLanes; ++l) {
+    const int* tet = tets + 4 * l;
+    for (int r = 0; r < 3; ++r) {
+      forces[3 * tet[1] + r] += H[r][0][l];
+      forces[3 * tet[2] + r] += H[r][1][l];
+      forces[3 * tet[3] + r] += H[r][2][l];
+      forces[3 * tet[0] + r] -= H[r][0][l] + H[r][1][l] + H[r][2][l];
+    }
+  }
+  double energy = 0.0;
+  if constexpr (kWithEnergy)
+    for (int l = 0; l < kLanes; ++l)
+      energy += volume[l] * psi[l];
+  return energy;
+}
+
+}  // namespace
 
 template <typename Kernel>
 void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
@@ -95,19 +160,34 @@ void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x,
   std::vector<double> chunk_energy(energy ? m_partition.num_chunks() : 0, 0.0);
   const double* positions = x.data();
   double* forces = f.data();
+  const auto scalar_tet = [&](int i) {
+    const int* tet = &m_sorted_tets[4 * i];
+    const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
+    const Matrix3d F = edge_matrix_at(positions, tet) * Dm_inv;
+    // Forces on vertices 1..3 are the columns of −V P Dm⁻ᵀ; vertex 0 balances them.
+    const Matrix3d H = -m_sorted_volume[i] * kernel.P(F) * Dm_inv.transpose();
+    for (int k = 0; k < 3; ++k)
+      Eigen::Map<Vector3d>(forces + 3 * tet[k + 1]) += H.col(k);
+    Eigen::Map<Vector3d>(forces + 3 * tet[0]) -= H.rowwise().sum();
+    return energy ? m_sorted_volume[i] * kernel.psi(F) : 0.0;
+  };
   for_each_chunk_colored(m_partition, [&](int chunk) {
     double sum = 0.0;
-    for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
-      const int* tet = &m_sorted_tets[4 * i];
-      const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
-      const Matrix3d F = edge_matrix_at(positions, tet) * Dm_inv;
-      // Forces on vertices 1..3 are the columns of −V P Dm⁻ᵀ; vertex 0 balances them.
-      const Matrix3d H = -m_sorted_volume[i] * kernel.P(F) * Dm_inv.transpose();
-      if (energy) sum += m_sorted_volume[i] * kernel.psi(F);
-      for (int k = 0; k < 3; ++k)
-        Eigen::Map<Vector3d>(forces + 3 * tet[k + 1]) += H.col(k);
-      Eigen::Map<Vector3d>(forces + 3 * tet[0]) -= H.rowwise().sum();
+    int i = m_partition.chunk_begin[chunk];
+    const int end = m_partition.chunk_begin[chunk + 1];
+    if constexpr (requires { typename Kernel::LaneKernel; }) {
+      const typename Kernel::LaneKernel lanes(m_lame);
+      for (; i + detail::kLanes <= end; i += detail::kLanes) {
+        const int group = i / detail::kLanes;
+        const double* lane_Dm_inv = &m_lane_Dm_inv[9 * detail::kLanes * group];
+        sum += energy ? lane_group_forces<true>(lanes, positions, &m_sorted_tets[4 * i],
+                                                lane_Dm_inv, &m_sorted_volume[i], forces)
+                      : lane_group_forces<false>(lanes, positions, &m_sorted_tets[4 * i],
+                                                 lane_Dm_inv, &m_sorted_volume[i], forces);
+      }
     }
+    for (; i < end; ++i)
+      sum += scalar_tet(i);
     if (energy) chunk_energy[chunk] = sum;
   });
   if (energy) {
@@ -204,6 +284,52 @@ void ElasticModel::build_stiffness_pattern() {
   }
 }
 
+namespace {
+
+/// StVK element stiffness in closed form, block (b, a) = ∂²W/∂x_b∂x_a:
+/// V [(g_aᵀ S g_b) I + λ (F g_b)(F g_a)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_a)(F g_b)ᵀ], g_k = ∇N_k.
+void stvk_stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double, 4, 3>& grad_N,
+                           const LameParameters& lame, double volume, Matrix3d (&blocks)[4][4]) {
+  const Matrix3d S = second_piola_stvk(F, lame);
+  const Matrix3d FFt = F * F.transpose();
+  Eigen::Matrix<double, 3, 4> Fg;  // columns F g_k
+  Eigen::Matrix<double, 3, 4> Sg;  // columns S g_k
+  for (int k = 0; k < 4; ++k) {
+    Fg.col(k) = F * grad_N.row(k).transpose();
+    Sg.col(k) = S * grad_N.row(k).transpose();
+  }
+  for (int b = 0; b < 4; ++b)
+    for (int a = b; a < 4; ++a) {
+      const double geometric = grad_N.row(a).dot(Sg.col(b));
+      const double gg = grad_N.row(a).dot(grad_N.row(b));
+      Matrix3d block = lame.lambda * Fg.col(b) * Fg.col(a).transpose() +
+                       lame.mu * Fg.col(a) * Fg.col(b).transpose() + lame.mu * gg * FFt;
+      block.diagonal().array() += geometric;
+      blocks[b][a] = volume * block;
+      if (a != b) blocks[a][b] = blocks[b][a].transpose();
+    }
+}
+
+/// Element stiffness blocks from the generic ∂²ψ/∂F²:
+/// K_ab = V Σ_{c,d} ∇N_a[c] ∇N_b[d] · (∂²ψ/∂F_{·c}∂F_{·d}).
+void generic_stiffness_blocks(const Matrix9d& d2psi, const Eigen::Matrix<double, 4, 3>& grad_N,
+                              double volume, Matrix3d (&blocks)[4][4]) {
+  Eigen::Matrix<double, 9, 12> right;  // column (b, r): Σ_d d2psi(:, 3d + r) ∇N_b[d]
+  for (int b = 0; b < 4; ++b)
+    for (int r = 0; r < 3; ++r)
+      right.col(3 * b + r) = grad_N(b, 0) * d2psi.col(r) + grad_N(b, 1) * d2psi.col(3 + r) +
+                             grad_N(b, 2) * d2psi.col(6 + r);
+  for (int a = 0; a < 4; ++a) {
+    const Eigen::Matrix<double, 3, 12> rows =
+        volume * (grad_N(a, 0) * right.middleRows<3>(0) + grad_N(a, 1) * right.middleRows<3>(3) +
+                  grad_N(a, 2) * right.middleRows<3>(6));
+    for (int b = 0; b < 4; ++b)
+      blocks[a][b] = rows.middleCols<3>(3 * b);
+  }
+}
+
+}  // namespace
+
 void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const {
   check_size(x, num_dofs());
   if (K.rows() != m_pattern.rows() || K.nonZeros() != m_pattern.nonZeros() ||
@@ -213,39 +339,30 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
   else
     std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
   double* values = K.valuePtr();
+  const bool closed_form_stvk = m_material.model == MaterialModel::stvk && !project_psd;
   for_each_chunk_colored(m_partition, [&](int chunk) {
+    Matrix3d blocks[4][4];
     for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
       const int* tet = &m_sorted_tets[4 * i];
       const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
       const Matrix3d F = edge_matrix_at(x.data(), tet) * Dm_inv;
-      Matrix9d d2psi = d2psi_dF2(m_material.model, F, m_lame);
-      if (project_psd) d2psi = project_to_psd<9>(d2psi);
-      // K_ab = V Σ_{c,d} ∇N_a[c] ∇N_b[d] · (∂²ψ/∂F_{·c}∂F_{·d}) as 3 × 3 blocks.
       const Eigen::Matrix<double, 4, 3> grad_N = shape_function_gradients(Dm_inv);
-      const double volume = m_sorted_volume[i];
-      Eigen::Matrix<double, 9, 12> right;  // d2psi · ∂F/∂x, column block b: Σ_d d2psi(:, d) ∇N_b[d]
-      for (int b = 0; b < 4; ++b)
-        for (int r = 0; r < 3; ++r) {
-          Vector9d column = Vector9d::Zero();
-          for (int d = 0; d < 3; ++d)
-            column += grad_N(b, d) * d2psi.col(3 * d + r);
-          right.col(3 * b + r) = column;
-        }
+      if (closed_form_stvk) {
+        stvk_stiffness_blocks(F, grad_N, m_lame, m_sorted_volume[i], blocks);
+      } else {
+        Matrix9d d2psi = d2psi_dF2(m_material.model, F, m_lame);
+        if (project_psd) d2psi = project_to_psd<9>(d2psi);
+        generic_stiffness_blocks(d2psi, grad_N, m_sorted_volume[i], blocks);
+      }
       const int* offsets = &m_block_offsets[48 * i];
-      for (int a = 0; a < 4; ++a) {
-        // rows of block a: Σ_c ∇N_a[c] right(3c + r', :)
-        Eigen::Matrix<double, 3, 12> rows = Eigen::Matrix<double, 3, 12>::Zero();
-        for (int c = 0; c < 3; ++c)
-          rows += grad_N(a, c) * right.middleRows<3>(3 * c);
-        rows *= volume;
+      for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b)
           for (int c = 0; c < 3; ++c) {
             double* entry = values + offsets[12 * a + 3 * b + c];
-            entry[0] += rows(0, 3 * b + c);
-            entry[1] += rows(1, 3 * b + c);
-            entry[2] += rows(2, 3 * b + c);
+            entry[0] += blocks[a][b](0, c);
+            entry[1] += blocks[a][b](1, c);
+            entry[2] += blocks[a][b](2, c);
           }
-      }
     }
   });
   m_element_evaluations += num_tets();

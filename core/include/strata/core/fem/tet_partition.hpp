@@ -15,7 +15,8 @@ namespace strata {
 struct TetPartition {
   /// order[i] = original index of the tet at position i of the sorted sequence.
   std::vector<int> order;
-  /// Chunk c covers sorted positions [chunk_begin[c], chunk_begin[c+1]).
+  /// Chunk c covers sorted positions [chunk_begin[c], chunk_begin[c+1]); every chunk begins at a
+  /// multiple of 8.
   std::vector<int> chunk_begin;
   /// Chunk indices of each colour; chunks of one colour share no vertex.
   std::vector<std::vector<int>> colors;

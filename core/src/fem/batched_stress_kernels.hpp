@@ -1,0 +1,102 @@
+#pragma once
+// Internal to elastic_model.cpp: force kernels that evaluate kLanes tets at once in
+// structure-of-arrays form, so that the compiler vectorises across tets (AVX2: 4 doubles).
+// Each kernel maps F (lane arrays) to P and, optionally, ψ — the same formulas as stvk.hpp and
+// neohookean.hpp, checked against them in the tests.
+#include <cmath>
+
+#include "strata/core/fem/material.hpp"
+#include "strata/core/fem/neohookean.hpp"
+
+namespace strata::detail {
+
+inline constexpr int kLanes = 4;
+using Lanes = double[kLanes];
+
+/// StVK: E = ½(FᵀF − I), S = λ tr(E) I + 2μ E, P = F S, ψ = μ E:E + λ/2 tr(E)².
+struct StvkLanes {
+  double mu, lambda;
+  explicit StvkLanes(const LameParameters& lame) : mu(lame.mu), lambda(lame.lambda) {}
+
+  template <bool kWithEnergy>
+  void operator()(const double (&F)[3][3][kLanes], double (&P)[3][3][kLanes],
+                  double (&psi)[kLanes]) const {
+    double E[3][3][kLanes];
+    for (int a = 0; a < 3; ++a)
+      for (int b = a; b < 3; ++b)
+        for (int l = 0; l < kLanes; ++l) {
+          const double dot =
+              F[0][a][l] * F[0][b][l] + F[1][a][l] * F[1][b][l] + F[2][a][l] * F[2][b][l];
+          E[a][b][l] = 0.5 * (dot - (a == b ? 1.0 : 0.0));
+          E[b][a][l] = E[a][b][l];
+        }
+    double trace[kLanes];
+    for (int l = 0; l < kLanes; ++l)
+      trace[l] = E[0][0][l] + E[1][1][l] + E[2][2][l];
+    double S[3][3][kLanes];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        for (int l = 0; l < kLanes; ++l)
+          S[a][b][l] = 2.0 * mu * E[a][b][l] + (a == b ? lambda * trace[l] : 0.0);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        for (int l = 0; l < kLanes; ++l)
+          P[r][c][l] = F[r][0][l] * S[0][c][l] + F[r][1][l] * S[1][c][l] + F[r][2][l] * S[2][c][l];
+    if constexpr (kWithEnergy) {
+      for (int l = 0; l < kLanes; ++l) {
+        double squared = 0.0;
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b)
+            squared += E[a][b][l] * E[a][b][l];
+        psi[l] = mu * squared + 0.5 * lambda * trace[l] * trace[l];
+      }
+    }
+  }
+};
+
+/// Stable neo-Hookean: P = μ'(1 − 1/(I_C + 1)) F + λ'(J − α) cof(F).
+struct NeoHookeanLanes {
+  NeoHookeanConstants k;
+  double rest_energy;  ///< the constant that makes ψ(I) = 0, as in psi_neohookean
+  explicit NeoHookeanLanes(const LameParameters& lame)
+      : k(neohookean_constants(lame)),
+        rest_energy(0.5 * k.lambda * (1.0 - k.alpha) * (1.0 - k.alpha) -
+                    0.5 * k.mu * std::log(4.0)) {}
+
+  template <bool kWithEnergy>
+  void operator()(const double (&F)[3][3][kLanes], double (&P)[3][3][kLanes],
+                  double (&psi)[kLanes]) const {
+    double cof[3][3][kLanes];
+    // Column c of cof(F) is the cross product of columns c+1 and c+2.
+    for (int c = 0; c < 3; ++c) {
+      const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+      for (int l = 0; l < kLanes; ++l) {
+        cof[0][c][l] = F[1][c1][l] * F[2][c2][l] - F[2][c1][l] * F[1][c2][l];
+        cof[1][c][l] = F[2][c1][l] * F[0][c2][l] - F[0][c1][l] * F[2][c2][l];
+        cof[2][c][l] = F[0][c1][l] * F[1][c2][l] - F[1][c1][l] * F[0][c2][l];
+      }
+    }
+    double Ic[kLanes], J[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      double sum = 0.0;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          sum += F[r][c][l] * F[r][c][l];
+      Ic[l] = sum;
+      J[l] = F[0][0][l] * cof[0][0][l] + F[1][0][l] * cof[1][0][l] + F[2][0][l] * cof[2][0][l];
+    }
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        for (int l = 0; l < kLanes; ++l)
+          P[r][c][l] = k.mu * (1.0 - 1.0 / (Ic[l] + 1.0)) * F[r][c][l] +
+                       k.lambda * (J[l] - k.alpha) * cof[r][c][l];
+    if constexpr (kWithEnergy) {
+      for (int l = 0; l < kLanes; ++l) {
+        psi[l] = 0.5 * k.mu * (Ic[l] - 3.0) + 0.5 * k.lambda * (J[l] - k.alpha) * (J[l] - k.alpha) -
+                 0.5 * k.mu * std::log(Ic[l] + 1.0) - rest_energy;
+      }
+    }
+  }
+};
+
+}  // namespace strata::detail
