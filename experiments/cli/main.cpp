@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
   run->add_option("--set", overrides,
                   "Override a scene key: key.path=value (value as JSON, else a string); "
                   "repeatable, e.g. --set solver.dt=1e-4 --set fixed.0.box.max=[0,1,1]")
-      ->take_last()
-      ->expected(1);
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   run->add_flag("-q,--quiet", quiet, "No progress bar, info lines or summary");
 
   CLI::App* info = app.add_subcommand("info", "Print counts, volume and quality of a tet mesh");

@@ -148,7 +148,7 @@ TEST(SceneParser, WrongTypes) {
   scene["mesh"]["box"]["cells"] = {4, 1.5, 1};
   EXPECT_EQ(parse_error(scene), "scene.json: mesh.box.cells.1: must be an integer");
   scene = minimal_scene();
-  scene["fixed"] = {{"box", {{"min", {0, 0, 0}}, {"max", {0, 0, "a"}}}}};
+  scene["fixed"] = json::array({{{"box", {{"min", {0, 0, 0}}, {"max", {0, 0, "a"}}}}}});
   EXPECT_EQ(parse_error(scene), "scene.json: fixed.0.box.max: must be an array of 3 numbers");
   EXPECT_THAT(parse_error(json::array()), HasSubstr("scene.json: scene: must be an object"));
 }
@@ -221,7 +221,7 @@ TEST(SceneParser, MalformedJsonReportsLineAndColumn) {
     read_json_file(file);
     FAIL() << "no error";
   } catch (const InputError& error) {
-    EXPECT_THAT(error.what(), HasSubstr(file.string() + ": line 3, column 17:"));
+    EXPECT_THAT(error.what(), HasSubstr(file.string() + ": line 3, column 16:"));
   }
   std::filesystem::remove(file);
   EXPECT_THROW(read_json_file(file), InputError);
