@@ -1,0 +1,137 @@
+#pragma once
+/// \file simulation.hpp
+/// The simulation driver: owns the elastic model, constraints, loads, contact and the chosen
+/// integrator or static solver, and advances one time step (dynamic) or one load step (static)
+/// per call. A library class: no I/O.
+///
+/// Lifecycle: construct (validates, selects regions, precomputes masses, loads and the stable step
+/// estimate) → set_state (optional initial velocity / shape) → while (!finished()) advance() →
+/// query positions, energies, reactions and counters at any point.
+///
+/// Reactions: for each Dirichlet group, the force the constraint exerts on the body,
+///   R = Σ_{i ∈ group} (m_i a_i − f_int,i − f_ext,i − f_damp,i − f_contact,i),
+/// with a_i the prescribed acceleration (zero in static mode, f_ext scaled by the load factor
+/// there), and its moment Σ (x_i − c) × R_i about the group's moment center c with the current
+/// positions as lever arms.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/dirichlet.hpp"
+#include "strata/core/sim/divergence_check.hpp"
+#include "strata/core/sim/ground_contact.hpp"
+#include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/solver_settings.hpp"
+
+namespace strata {
+
+struct DynamicsSystem;
+class ImplicitEuler;
+class StaticSolver;
+
+/// Reaction of one Dirichlet group.
+struct GroupReaction {
+  std::string name;
+  Vector3d force = Vector3d::Zero();          ///< [N], exerted by the constraint on the body
+  Vector3d moment = Vector3d::Zero();         ///< [N·m] about moment_center
+  Vector3d moment_center = Vector3d::Zero();  ///< [m]
+};
+
+/// Work counters.
+struct SimulationCounters {
+  long steps = 0;                     ///< time or load steps taken
+  long newton_iterations = 0;         ///< over all implicit / static steps
+  long long element_evaluations = 0;  ///< from ElasticModel
+  long factorizations = 0;            ///< numeric factorisations (or CG setups)
+};
+
+class Simulation {
+ public:
+  /// `mesh` must be validated and positively oriented (validate_tet_mesh, orient_tets).
+  /// Throws InputError for a vertex without tets, invalid material / settings / regions / ground,
+  /// an empty Dirichlet group or load region, or static mode without any Dirichlet group.
+  Simulation(TetMesh mesh, const Material& material, const std::vector<DirichletSpec>& dirichlet,
+             const std::vector<RegionLoad>& loads, const std::optional<GroundPlane>& ground,
+             const Vector3d& gravity, const SolverSettings& settings);
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  /// Replaces the state (3·#V each; e.g. an initial velocity); Dirichlet DOFs are reset to their
+  /// targets at the current time. Throws InputError on a size mismatch or non-finite values.
+  void set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velocities);
+
+  /// One time step of `dt` (dynamic) or one load step (static). Throws DivergenceError naming the
+  /// step and time (or load factor) if the state diverges or Newton fails; std::logic_error if
+  /// called when finished().
+  void advance();
+  /// Dynamic: t ≥ duration (up to 10⁻⁹ dt; the last step is not shortened, so the run takes
+  /// ⌈duration/dt⌉ steps). Static: all load_steps done.
+  bool finished() const;
+
+  const VectorXd& positions() const { return m_x; }   ///< 3·#V [m]
+  const VectorXd& velocities() const { return m_v; }  ///< 3·#V [m/s] (zero in static mode)
+  /// Dynamic: simulated time [s]; static: the load factor k/N.
+  double time() const;
+  /// Dirichlet ramp / load factor s ∈ [0, 1] of the current state.
+  double load_factor() const;
+  long step_count() const { return m_steps; }
+
+  /// CFL estimate of the largest stable explicit step [s] (stable_time_step.hpp); reported, never
+  /// applied.
+  double stable_dt_estimate() const { return m_stable_dt; }
+
+  std::vector<GroupReaction> reactions() const;
+  double kinetic_energy() const;  ///< ½ vᵀ M v [J]
+  double elastic_energy() const;  ///< Ψ(x) [J]
+  /// Potential of the dead loads −s_f f_extᵀ(x − X) [J] (s_f = load factor in static mode, 1 in
+  /// dynamic mode).
+  double external_potential_energy() const;
+  SimulationCounters counters() const;
+
+  const TetMesh& mesh() const { return m_mesh; }
+  const ElasticModel& model() const { return *m_model; }
+  const SolverSettings& settings() const { return m_settings; }
+  const std::vector<DirichletGroup>& dirichlet_groups() const { return m_groups; }
+  const MatrixX3i& boundary() const { return m_boundary; }       ///< boundary triangles #F × 3
+  const VectorXd& vertex_mass() const { return m_vertex_mass; }  ///< #V [kg]
+  /// Full (unscaled) external force vector, 3·#V [N].
+  const VectorXd& external_forces() const { return m_external; }
+  const DivergenceLimits& divergence_limits() const { return m_limits; }
+
+ private:
+  void advance_dynamic();
+  void advance_static();
+  [[noreturn]] void throw_newton_failure(const std::string& context, int iterations,
+                                         double residual) const;
+
+  TetMesh m_mesh;
+  Material m_material;
+  SolverSettings m_settings;
+  std::unique_ptr<ElasticModel> m_model;
+  MatrixX3i m_boundary;
+  VectorXd m_vertex_mass;
+  VectorXd m_dof_mass;
+  VectorXd m_external;
+  std::vector<DirichletGroup> m_groups;
+  std::vector<char> m_constrained;
+  std::optional<GroundPlane> m_ground;
+  double m_ground_stiffness = 0.0;
+  double m_diagonal = 0.0;
+  double m_stable_dt = 0.0;
+  DivergenceLimits m_limits;
+  std::unique_ptr<DynamicsSystem> m_system;
+  std::unique_ptr<ImplicitEuler> m_implicit;
+  std::unique_ptr<StaticSolver> m_static;
+
+  VectorXd m_x;
+  VectorXd m_v;
+  VectorXd m_x_previous;  ///< static: equilibrium of the previous load step (extrapolation)
+  long m_steps = 0;
+  long m_newton_iterations = 0;
+};
+
+}  // namespace strata

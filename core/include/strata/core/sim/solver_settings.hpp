@@ -1,0 +1,44 @@
+#pragma once
+/// \file solver_settings.hpp
+/// Run settings of a simulation: mode, integrator, step sizes, linear solver, Newton controls.
+#include <string>
+
+namespace strata {
+
+/// dynamic: time integration; static_equilibrium: quasi-static load stepping ("static" in scenes).
+enum class SimulationMode { dynamic, static_equilibrium };
+enum class Integrator { symplectic_euler, rk4, implicit_euler };
+/// cholmod: CHOLMOD supernodal Cholesky; cg: conjugate gradients with incomplete Cholesky.
+enum class LinearSolverKind { cholmod, cg };
+
+struct SolverSettings {
+  SimulationMode mode = SimulationMode::dynamic;
+  Integrator integrator = Integrator::implicit_euler;
+  double dt = 1e-3;       ///< time step [s] (dynamic)
+  double duration = 1.0;  ///< simulated time [s] (dynamic)
+  /// Dirichlet ramp time [s] (dynamic): s = min(t / ramp_time, 1); 0 means `duration`.
+  double ramp_time = 0.0;
+  int load_steps = 10;  ///< N: load factor k/N at step k (static)
+  LinearSolverKind linear_solver = LinearSolverKind::cholmod;
+  int max_newton_iterations = 50;
+  /// Newton stops when ‖∇E‖ over the free DOFs ≤ tolerance × force scale (static: the applied
+  /// external load, or the internal forces of the first guess when there is no load).
+  double newton_tolerance = 1e-10;
+  /// Ground penalty stiffness factor (static mode), see ground_penalty_stiffness.
+  double contact_stiffness_factor = 100.0;
+};
+
+std::string to_string(SimulationMode mode);    ///< "dynamic" | "static"
+std::string to_string(Integrator integrator);  ///< "symplectic_euler" | "rk4" | "implicit_euler"
+std::string to_string(LinearSolverKind kind);  ///< "cholmod" | "cg"
+/// Parsers for scene names; throw InputError listing the valid names.
+SimulationMode simulation_mode_from_string(const std::string& name);
+Integrator integrator_from_string(const std::string& name);
+LinearSolverKind linear_solver_from_string(const std::string& name);
+
+/// Throws InputError naming `where` (e.g. "solver") unless dt > 0, duration > 0, ramp_time ≥ 0,
+/// load_steps ≥ 1, max_newton_iterations ≥ 1, newton_tolerance > 0, contact factor > 0 (all
+/// finite).
+void validate_solver_settings(const SolverSettings& settings, const std::string& where);
+
+}  // namespace strata

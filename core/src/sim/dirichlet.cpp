@@ -1,0 +1,120 @@
+#include "strata/core/sim/dirichlet.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+Vector3d DirichletGroup::target_position(const Vector3d& X, double s) const {
+  switch (spec.kind) {
+    case DirichletKind::fixed:
+      return X;
+    case DirichletKind::displacement:
+      return X + s * spec.displacement;
+    case DirichletKind::rotation: {
+      const Eigen::AngleAxisd rotation(s * spec.angle, spec.axis.normalized());
+      return moment_center + rotation * (X - moment_center);
+    }
+  }
+  return X;
+}
+
+Vector3d DirichletGroup::target_velocity(const Vector3d& X, double s, double ds_dt) const {
+  switch (spec.kind) {
+    case DirichletKind::fixed:
+      return Vector3d::Zero();
+    case DirichletKind::displacement:
+      return ds_dt * spec.displacement;
+    case DirichletKind::rotation: {
+      const Vector3d omega = ds_dt * spec.angle * spec.axis.normalized();
+      return omega.cross(target_position(X, s) - moment_center);
+    }
+  }
+  return Vector3d::Zero();
+}
+
+Vector3d DirichletGroup::target_acceleration(const Vector3d& X, double s, double ds_dt) const {
+  if (spec.kind != DirichletKind::rotation) return Vector3d::Zero();
+  const Vector3d omega = ds_dt * spec.angle * spec.axis.normalized();
+  return omega.cross(omega.cross(target_position(X, s) - moment_center));
+}
+
+std::vector<DirichletGroup> resolve_dirichlet_groups(const std::vector<DirichletSpec>& specs,
+                                                     ConstRef<MatrixX3d> rest_positions,
+                                                     double tolerance) {
+  const Index num_vertices = rest_positions.rows();
+  std::vector<std::vector<int>> selections;
+  VectorXi owner = VectorXi::Constant(num_vertices, -1);
+  for (size_t g = 0; g < specs.size(); ++g) {
+    const DirichletSpec& spec = specs[g];
+    validate_region(spec.region, spec.name + ".region");
+    if (spec.kind == DirichletKind::rotation &&
+        (!spec.axis.allFinite() || spec.axis.norm() == 0.0 || !std::isfinite(spec.angle)))
+      throw InputError(spec.name + ": rotation needs a finite non-zero axis and a finite angle");
+    if (!spec.components[0] && !spec.components[1] && !spec.components[2])
+      throw InputError(spec.name + ": no component is prescribed");
+    if (spec.kind == DirichletKind::displacement && !spec.displacement.allFinite())
+      throw InputError(spec.name + ": displacement must be finite");
+    selections.push_back(select_vertices(spec.region, rest_positions, tolerance));
+    if (selections.back().empty()) throw InputError(spec.name + ": region selects no vertex");
+    for (int v : selections.back())
+      owner[v] = static_cast<int>(g);
+  }
+  std::vector<DirichletGroup> groups(specs.size());
+  for (size_t g = 0; g < specs.size(); ++g) {
+    DirichletGroup& group = groups[g];
+    group.spec = specs[g];
+    for (int v : selections[g])
+      if (owner[v] == static_cast<int>(g)) group.vertices.push_back(v);
+    if (group.vertices.empty())
+      throw InputError(specs[g].name +
+                       ": region selects no vertex that a later group leaves to it");
+    if (specs[g].kind == DirichletKind::rotation && specs[g].has_center) {
+      group.moment_center = specs[g].center;
+    } else {
+      Vector3d sum = Vector3d::Zero();
+      for (int v : group.vertices)
+        sum += rest_positions.row(v).transpose();
+      group.moment_center = sum / static_cast<double>(group.vertices.size());
+    }
+  }
+  return groups;
+}
+
+VectorXi dirichlet_owner(const std::vector<DirichletGroup>& groups, Index num_vertices) {
+  VectorXi owner = VectorXi::Constant(num_vertices, -1);
+  for (size_t g = 0; g < groups.size(); ++g)
+    for (int v : groups[g].vertices)
+      owner[v] = static_cast<int>(g);
+  return owner;
+}
+
+std::vector<char> dirichlet_dof_mask(const std::vector<DirichletGroup>& groups,
+                                     Index num_vertices) {
+  std::vector<char> mask(3 * num_vertices, 0);
+  for (const DirichletGroup& group : groups)
+    for (int v : group.vertices)
+      for (int c = 0; c < 3; ++c)
+        mask[3 * v + c] = group.spec.components[c] ? 1 : 0;
+  return mask;
+}
+
+void apply_dirichlet(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest, double s,
+                     double ds_dt, VectorXd& x, VectorXd& v) {
+  for (const DirichletGroup& group : groups) {
+    for (int vertex : group.vertices) {
+      const Vector3d X = rest.segment<3>(3 * vertex);
+      const Vector3d target_x = group.target_position(X, s);
+      const Vector3d target_v = group.target_velocity(X, s, ds_dt);
+      for (int c = 0; c < 3; ++c) {
+        if (!group.spec.components[c]) continue;
+        x[3 * vertex + c] = target_x[c];
+        v[3 * vertex + c] = target_v[c];
+      }
+    }
+  }
+}
+
+}  // namespace strata

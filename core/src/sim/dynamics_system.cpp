@@ -1,0 +1,52 @@
+#include "strata/core/sim/dynamics_system.hpp"
+
+#include <algorithm>
+
+namespace strata {
+
+double DynamicsSystem::ramp(double t) const {
+  return std::clamp(t / ramp_time, 0.0, 1.0);
+}
+
+double DynamicsSystem::ramp_rate(double t) const {
+  return t < ramp_time ? 1.0 / ramp_time : 0.0;
+}
+
+void DynamicsSystem::apply_constraints(double t, VectorXd& x, VectorXd& v) const {
+  apply_dirichlet(groups, model.rest_positions(), ramp(t), ramp_rate(t), x, v);
+}
+
+void DynamicsSystem::add_damping_forces(const VectorXd& x, const VectorXd& v, const VectorXd& f_int,
+                                        VectorXd& f) const {
+  if (mass_damping > 0.0) f.array() -= mass_damping * dof_mass.array() * v.array();
+  if (stiffness_damping <= 0.0) return;
+  const double speed = v.lpNorm<Eigen::Infinity>();
+  if (speed == 0.0) return;
+  const double epsilon = 1e-7 * diagonal / speed;
+  VectorXd f_shifted;
+  const VectorXd x_shifted = x + epsilon * v;
+  model.forces(x_shifted, f_shifted);
+  // −β K v = β (f_int(x + εv) − f_int(x)) / ε
+  f += (stiffness_damping / epsilon) * (f_shifted - f_int);
+}
+
+void DynamicsSystem::accelerations(double t, const VectorXd& x, const VectorXd& v,
+                                   VectorXd& a) const {
+  VectorXd f_int;
+  model.forces(x, f_int);
+  VectorXd f = f_int + external_forces;
+  add_damping_forces(x, v, f_int, f);
+  a = f.array() / dof_mass.array();
+  const double s = ramp(t);
+  const double ds_dt = ramp_rate(t);
+  const VectorXd& rest = model.rest_positions();
+  for (const DirichletGroup& group : groups) {
+    for (int vertex : group.vertices) {
+      const Vector3d target = group.target_acceleration(rest.segment<3>(3 * vertex), s, ds_dt);
+      for (int c = 0; c < 3; ++c)
+        if (group.spec.components[c]) a[3 * vertex + c] = target[c];
+    }
+  }
+}
+
+}  // namespace strata

@@ -1,0 +1,238 @@
+#include "strata/core/sim/simulation.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/fem/lumped_mass.hpp"
+#include "strata/core/sim/dynamics_system.hpp"
+#include "strata/core/sim/explicit_integrators.hpp"
+#include "strata/core/sim/implicit_euler.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
+#include "strata/core/sim/static_solver.hpp"
+
+namespace strata {
+
+namespace {
+
+std::string format_number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.3g", value);
+  return buffer;
+}
+
+bool is_static(const SolverSettings& settings) {
+  return settings.mode == SimulationMode::static_equilibrium;
+}
+
+}  // namespace
+
+Simulation::Simulation(TetMesh mesh, const Material& material,
+                       const std::vector<DirichletSpec>& dirichlet,
+                       const std::vector<RegionLoad>& loads,
+                       const std::optional<GroundPlane>& ground, const Vector3d& gravity,
+                       const SolverSettings& settings)
+    : m_mesh(std::move(mesh)), m_material(material), m_settings(settings), m_ground(ground) {
+  validate_material(m_material, "material");
+  validate_solver_settings(m_settings, "solver");
+  if (m_ground) validate_ground(*m_ground, "ground");
+  if (!gravity.allFinite()) throw InputError("gravity: must be finite");
+  std::vector<char> referenced(m_mesh.vertices.rows(), 0);
+  for (Index t = 0; t < m_mesh.tets.rows(); ++t)
+    for (int k = 0; k < 4; ++k)
+      referenced[m_mesh.tets(t, k)] = 1;
+  for (size_t v = 0; v < referenced.size(); ++v)
+    if (!referenced[v])
+      throw InputError("mesh: vertex " + std::to_string(v) + " belongs to no tet");
+  if (is_static(m_settings) && dirichlet.empty())
+    throw InputError(
+        "dirichlet: static mode needs at least one Dirichlet group against rigid motion");
+
+  m_model = std::make_unique<ElasticModel>(m_mesh.vertices, m_mesh.tets, m_material);
+  const Index num_vertices = m_mesh.vertices.rows();
+  m_boundary = boundary_faces(m_mesh.tets);
+  m_vertex_mass = lumped_vertex_mass(m_model->rest_data().rest_volume, m_mesh.tets, num_vertices,
+                                     m_material.density);
+  m_dof_mass.resize(3 * num_vertices);
+  for (Index v = 0; v < num_vertices; ++v)
+    m_dof_mass.segment<3>(3 * v).setConstant(m_vertex_mass[v]);
+
+  const auto [lo, hi] = bounding_box(m_mesh.vertices);
+  m_diagonal = (hi - lo).norm();
+  const double tolerance = region_tolerance(m_mesh.vertices);
+  m_groups = resolve_dirichlet_groups(dirichlet, m_mesh.vertices, tolerance);
+  m_constrained = dirichlet_dof_mask(m_groups, num_vertices);
+  m_external = strata::external_forces(m_mesh.vertices, m_boundary, m_vertex_mass, gravity, loads,
+                                       tolerance);
+  m_stable_dt = stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material.p_wave_speed());
+  m_limits = default_divergence_limits(m_material, m_diagonal);
+  if (m_ground)
+    m_ground_stiffness = ground_penalty_stiffness(m_material.youngs_modulus,
+                                                  mean_edge_length(m_mesh.vertices, m_mesh.tets),
+                                                  m_settings.contact_stiffness_factor);
+
+  m_x = m_model->rest_positions();
+  m_v = VectorXd::Zero(m_x.size());
+  m_x_previous = m_x;
+  const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
+  m_system.reset(new DynamicsSystem{*m_model, m_dof_mass, m_external, m_material.mass_damping,
+                                    m_material.stiffness_damping, m_groups, m_constrained,
+                                    ramp_time, m_diagonal});
+  if (is_static(m_settings)) {
+    m_static = std::make_unique<StaticSolver>(
+        *m_model, m_external, m_groups, m_constrained, m_ground, m_ground_stiffness,
+        m_settings.linear_solver, m_settings.max_newton_iterations, m_settings.newton_tolerance);
+  } else {
+    if (m_settings.integrator == Integrator::implicit_euler)
+      m_implicit = std::make_unique<ImplicitEuler>(*m_system, m_settings.linear_solver,
+                                                   m_settings.max_newton_iterations,
+                                                   m_settings.newton_tolerance);
+    m_system->apply_constraints(0.0, m_x, m_v);
+  }
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velocities) {
+  if (positions.size() != m_x.size() || velocities.size() != m_v.size())
+    throw InputError("initial state: expected " + std::to_string(m_x.size()) +
+                     " position and velocity entries");
+  if (!positions.allFinite() || !velocities.allFinite())
+    throw InputError("initial state: positions and velocities must be finite");
+  m_x = positions;
+  m_v = is_static(m_settings) ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
+  if (is_static(m_settings)) {
+    apply_dirichlet(m_groups, m_model->rest_positions(), load_factor(), 0.0, m_x, m_v);
+    m_x_previous = m_x;
+  } else {
+    m_system->apply_constraints(time(), m_x, m_v);
+  }
+}
+
+double Simulation::time() const {
+  if (is_static(m_settings)) return load_factor();
+  return static_cast<double>(m_steps) * m_settings.dt;
+}
+
+double Simulation::load_factor() const {
+  if (is_static(m_settings))
+    return static_cast<double>(m_steps) / static_cast<double>(m_settings.load_steps);
+  return m_system->ramp(time());
+}
+
+bool Simulation::finished() const {
+  if (is_static(m_settings)) return m_steps >= m_settings.load_steps;
+  return time() >= m_settings.duration - 1e-9 * m_settings.dt;
+}
+
+void Simulation::advance() {
+  STRATA_VERIFY(!finished(), "Simulation::advance called after the run finished");
+  if (is_static(m_settings))
+    advance_static();
+  else
+    advance_dynamic();
+}
+
+void Simulation::throw_newton_failure(const std::string& context, int iterations,
+                                      double residual) const {
+  const long step = m_steps + 1;
+  const double t = is_static(m_settings) ? static_cast<double>(step) / m_settings.load_steps
+                                         : static_cast<double>(step) * m_settings.dt;
+  throw DivergenceError(context + ": Newton did not converge at step " + std::to_string(step) +
+                            (is_static(m_settings) ? ", load factor " : ", t = ") +
+                            std::to_string(t) + " after " + std::to_string(iterations) +
+                            " iterations (gradient norm " + format_number(residual) + " N)",
+                        step, t);
+}
+
+void Simulation::advance_dynamic() {
+  const double t = time();
+  const double h = m_settings.dt;
+  switch (m_settings.integrator) {
+    case Integrator::symplectic_euler:
+      symplectic_euler_step(*m_system, t, h, m_x, m_v);
+      break;
+    case Integrator::rk4:
+      rk4_step(*m_system, t, h, m_x, m_v);
+      break;
+    case Integrator::implicit_euler: {
+      const NewtonResult result = m_implicit->step(t, h, m_x, m_v);
+      m_newton_iterations += result.iterations;
+      if (!result.converged)
+        throw_newton_failure("implicit_euler", result.iterations, result.residual);
+      break;
+    }
+  }
+  if (m_ground) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
+  ++m_steps;
+  check_divergence(*m_model, m_x, m_v, m_limits, m_steps, time(), to_string(m_settings.integrator));
+}
+
+void Simulation::advance_static() {
+  const double lambda = static_cast<double>(m_steps + 1) / m_settings.load_steps;
+  VectorXd guess = m_x;
+  if (m_steps >= 1) guess += m_x - m_x_previous;  // linear extrapolation along the load path
+  const NewtonResult result = m_static->solve(lambda, guess);
+  m_newton_iterations += result.iterations;
+  if (!result.converged) throw_newton_failure("static", result.iterations, result.residual);
+  m_x_previous = m_x;
+  m_x = guess;
+  ++m_steps;
+  check_divergence(*m_model, m_x, VectorXd(), m_limits, m_steps, lambda, "static");
+}
+
+std::vector<GroupReaction> Simulation::reactions() const {
+  VectorXd f_int;
+  m_model->forces(m_x, f_int);
+  VectorXd f = f_int;
+  VectorXd mass_times_acceleration = VectorXd::Zero(m_x.size());
+  if (is_static(m_settings)) {
+    f += load_factor() * m_external + m_static->contact_forces(m_x);
+  } else {
+    f += m_external;
+    m_system->add_damping_forces(m_x, m_v, f_int, f);
+    m_system->accelerations(time(), m_x, m_v, mass_times_acceleration);
+    mass_times_acceleration.array() *= m_dof_mass.array();
+  }
+  std::vector<GroupReaction> reactions;
+  for (const DirichletGroup& group : m_groups) {
+    GroupReaction reaction;
+    reaction.name = group.spec.name;
+    reaction.moment_center = group.moment_center;
+    for (int v : group.vertices) {
+      Vector3d r = mass_times_acceleration.segment<3>(3 * v) - f.segment<3>(3 * v);
+      for (int c = 0; c < 3; ++c)
+        if (!group.spec.components[c]) r[c] = 0.0;  // free coordinates carry no reaction
+      reaction.force += r;
+      reaction.moment += (m_x.segment<3>(3 * v) - group.moment_center).cross(r);
+    }
+    reactions.push_back(reaction);
+  }
+  return reactions;
+}
+
+double Simulation::kinetic_energy() const {
+  return 0.5 * m_v.dot(m_dof_mass.cwiseProduct(m_v));
+}
+
+double Simulation::elastic_energy() const {
+  return m_model->energy(m_x);
+}
+
+double Simulation::external_potential_energy() const {
+  const double scale = is_static(m_settings) ? load_factor() : 1.0;
+  return -scale * m_external.dot(m_x - m_model->rest_positions());
+}
+
+SimulationCounters Simulation::counters() const {
+  SimulationCounters counters;
+  counters.steps = m_steps;
+  counters.newton_iterations = m_newton_iterations;
+  counters.element_evaluations = m_model->element_evaluations();
+  if (m_implicit) counters.factorizations = m_implicit->linear_solver().factorizations();
+  if (m_static) counters.factorizations = m_static->linear_solver().factorizations();
+  return counters;
+}
+
+}  // namespace strata

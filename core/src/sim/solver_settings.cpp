@@ -1,0 +1,64 @@
+#include "strata/core/sim/solver_settings.hpp"
+
+#include <cmath>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+std::string to_string(SimulationMode mode) {
+  return mode == SimulationMode::dynamic ? "dynamic" : "static";
+}
+
+std::string to_string(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::symplectic_euler:
+      return "symplectic_euler";
+    case Integrator::rk4:
+      return "rk4";
+    case Integrator::implicit_euler:
+      return "implicit_euler";
+  }
+  return "?";
+}
+
+std::string to_string(LinearSolverKind kind) {
+  return kind == LinearSolverKind::cholmod ? "cholmod" : "cg";
+}
+
+SimulationMode simulation_mode_from_string(const std::string& name) {
+  if (name == "dynamic") return SimulationMode::dynamic;
+  if (name == "static") return SimulationMode::static_equilibrium;
+  throw InputError("unknown mode '" + name + "' (valid: dynamic, static)");
+}
+
+Integrator integrator_from_string(const std::string& name) {
+  if (name == "symplectic_euler") return Integrator::symplectic_euler;
+  if (name == "rk4") return Integrator::rk4;
+  if (name == "implicit_euler") return Integrator::implicit_euler;
+  throw InputError("unknown integrator '" + name +
+                   "' (valid: symplectic_euler, rk4, implicit_euler)");
+}
+
+LinearSolverKind linear_solver_from_string(const std::string& name) {
+  if (name == "cholmod") return LinearSolverKind::cholmod;
+  if (name == "cg") return LinearSolverKind::cg;
+  throw InputError("unknown linear solver '" + name + "' (valid: cholmod, cg)");
+}
+
+void validate_solver_settings(const SolverSettings& s, const std::string& where) {
+  auto positive = [&](double value, const char* key) {
+    if (!std::isfinite(value) || value <= 0.0)
+      throw InputError(where + "." + key + ": must be a finite number > 0");
+  };
+  positive(s.dt, "dt");
+  positive(s.duration, "duration");
+  positive(s.newton_tolerance, "newton_tolerance");
+  positive(s.contact_stiffness_factor, "contact_stiffness_factor");
+  if (!std::isfinite(s.ramp_time) || s.ramp_time < 0.0)
+    throw InputError(where + ".ramp_time: must be a finite number >= 0");
+  if (s.load_steps < 1) throw InputError(where + ".load_steps: must be >= 1");
+  if (s.max_newton_iterations < 1) throw InputError(where + ".max_newton_iterations: must be >= 1");
+}
+
+}  // namespace strata
