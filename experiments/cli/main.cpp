@@ -54,7 +54,8 @@ int run_info(const std::filesystem::path& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"strata: tetrahedral FEM simulation of deformable solids"};
+  CLI::App app{"strata: tetrahedral FEM simulation of deformable solids", "strata"};
+  app.set_version_flag("--version", STRATA_VERSION);
   app.require_subcommand(1);
 
   CLI::App* run = app.add_subcommand("run", "Run a scene file and write its outputs");
@@ -87,6 +88,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& error) {
     return app.exit(error);
   } catch (const CLI::CallForAllHelp& error) {
+    return app.exit(error);
+  } catch (const CLI::CallForVersion& error) {
     return app.exit(error);
   } catch (const CLI::ParseError& error) {
     return fail(error.what(), kExitBadInput);
