@@ -1,7 +1,7 @@
 # One Eigen memory ABI for strata and everything that includes its headers.
 #
-# strata_core is built with -march=native (STRATA_NATIVE) while tests, the CLI and programs that use
-# an installed strata are usually not. Eigen 3.4 derives its alignment from the instruction set:
+# strata's own code may be built for a wider instruction set (STRATA_AVX2: -march=x86-64-v3) than
+# the programs that use an installed strata (and, in this tree, than some tests). Eigen 3.4 derives its alignment from the instruction set:
 # with AVX-512 it aligns heap blocks to 64 bytes with its own allocator (pointer to the malloc block
 # stored just before the data) and fixed-size types to 32/64 bytes; without AVX it calls plain
 # malloc/free and aligns to 16. A matrix allocated inside libstrata_core and freed by the caller
