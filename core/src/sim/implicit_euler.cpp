@@ -61,6 +61,7 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
   settings.force_scale = M.cwiseProduct(y - x_tilde).norm() / (h * h) + f_int.norm() +
                          sys.external_forces.norm() + M.cwiseProduct(v).norm() / h;
   settings.step_tolerance = 1e-13 * sys.diagonal;
+  settings.residual_floor = internal_force_roundoff(model);
   const LameParameters lame = model.material().lame();
   settings.energy_scale = (2 * lame.mu + lame.lambda) * model.rest_data().rest_volume.sum() +
                           std::abs(sys.external_forces.dot(y)) +

@@ -1,6 +1,10 @@
 #include "strata/core/sim/newton_solver.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "strata/core/sim/stable_time_step.hpp"
 
 namespace strata {
 
@@ -24,6 +28,13 @@ bool solve_with_shift(SpdSolver& solver, SparseMatrixd& H, const VectorXd& rhs, 
 
 }  // namespace
 
+double internal_force_roundoff(const ElasticModel& model) {
+  const LameParameters lame = model.material().lame();
+  const double h = mean_edge_length(unflatten(model.rest_positions()), model.tets());
+  return 1e3 * std::numeric_limits<double>::epsilon() * (2 * lame.mu + lame.lambda) * h * h *
+         std::sqrt(static_cast<double>(model.num_dofs()));
+}
+
 NewtonResult newton_minimize(const NewtonObjective& objective, const DofReduction& reduction,
                              SpdSolver& solver, const NewtonSettings& settings, VectorXd& x) {
   NewtonResult result;
@@ -34,7 +45,8 @@ NewtonResult newton_minimize(const NewtonObjective& objective, const DofReductio
   VectorXd g = reduction.restrict_vector(gradient);
   result.residual = g.norm();
   double energy = objective.energy(x);
-  const double target = settings.tolerance * settings.force_scale;
+  const double target =
+      std::max(settings.tolerance * settings.force_scale, settings.residual_floor);
   while (true) {
     if (result.residual <= target || reduction.num_free() == 0) {
       result.converged = true;

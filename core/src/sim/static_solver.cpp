@@ -55,6 +55,7 @@ NewtonResult StaticSolver::solve(double load_factor, VectorXd& x) {
   settings.max_iterations = m_max_iterations;
   settings.tolerance = m_tolerance;
   settings.force_scale = std::max((lambda * m_external_forces).norm(), f_int.norm());
+  settings.residual_floor = internal_force_roundoff(m_model);
   const VectorXd& rest = m_model.rest_positions();
   const double size =
       (unflatten(rest).colwise().maxCoeff() - unflatten(rest).colwise().minCoeff()).norm();

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "strata/core/common/types.hpp"
+#include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/sim/dof_reduction.hpp"
 #include "strata/core/sim/linear_solver.hpp"
 
@@ -21,8 +22,11 @@ struct NewtonObjective {
 
 struct NewtonSettings {
   int max_iterations = 50;
-  double tolerance = 1e-10;  ///< stop when ‖g_free‖ ≤ tolerance · force_scale
+  double tolerance = 1e-10;  ///< stop when ‖g_free‖ ≤ max(tolerance · force_scale, residual_floor)
   double force_scale = 1.0;  ///< [N]
+  /// Round-off level of the gradient [N] (see internal_force_roundoff); below it no iteration can
+  /// make progress.
+  double residual_floor = 0.0;
   /// Magnitude of the terms that make up E [J] (e.g. (2μ + λ)·volume for elastic energy): when
   /// the predicted decrease |gᵀΔ| is below 10⁻¹¹ × max(|E|, energy_scale), E cannot resolve it and
   /// the step is judged by the gradient norm instead.
@@ -36,6 +40,11 @@ struct NewtonResult {
   int iterations = 0;
   double residual = 0.0;  ///< final ‖g_free‖ [N]
 };
+
+/// Round-off level of the elastic forces of `model` near the rest state [N]:
+/// 10³ ε_machine · (2μ + λ) · h̄² · √(3·#V), with h̄ the mean rest edge length — the stress noise
+/// of F ≈ I times a face area, accumulated over the DOFs.
+double internal_force_roundoff(const ElasticModel& model);
 
 /// Minimises from the initial guess `x` (3·#V, updated in place). Each iteration: gradient,
 /// Hessian, reduce to free DOFs, solve H Δ = −g (on failure, retry with a growing diagonal shift),
