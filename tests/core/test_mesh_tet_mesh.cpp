@@ -1,6 +1,10 @@
 // Mesh utilities: the box generator, orientation, validation errors, boundary faces.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <set>
+
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 
@@ -36,6 +40,37 @@ TEST(BoxTetMesh, IsConformingItsBoundaryIsTheBoxSurface) {
   }
   EXPECT_NEAR(volume, 24.0, 1e-12);
   EXPECT_LT(normal_sum.norm(), 1e-12);
+}
+
+TEST(BoxTetMesh, EvenCellCountsGiveAMirrorSymmetricMesh) {
+  // With alternating diagonals the mesh maps onto itself under reflection in each mid-plane, so a
+  // symmetric load cannot produce an asymmetric response.
+  const std::array<int, 3> n = {4, 2, 6};
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(4, 2, 6), n);
+  const auto vertex_index = [&](int i, int j, int k) {
+    return i + (n[0] + 1) * (j + (n[1] + 1) * k);
+  };
+  std::set<std::array<int, 4>> tets;
+  for (Index t = 0; t < mesh.tets.rows(); ++t) {
+    std::array<int, 4> sorted = {mesh.tets(t, 0), mesh.tets(t, 1), mesh.tets(t, 2),
+                                 mesh.tets(t, 3)};
+    std::sort(sorted.begin(), sorted.end());
+    tets.insert(sorted);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const auto& tet : tets) {
+      std::array<int, 4> mirrored;
+      for (int c = 0; c < 4; ++c) {
+        const Vector3d p = mesh.vertices.row(tet[c]);
+        std::array<int, 3> ijk = {int(std::lround(p[0])), int(std::lround(p[1])),
+                                  int(std::lround(p[2]))};
+        ijk[axis] = n[axis] - ijk[axis];
+        mirrored[c] = vertex_index(ijk[0], ijk[1], ijk[2]);
+      }
+      std::sort(mirrored.begin(), mirrored.end());
+      EXPECT_TRUE(tets.count(mirrored)) << "axis " << axis;
+    }
+  }
 }
 
 TEST(TetMesh, OrientTetsFlipsNegativeTetsAndCountsThem) {

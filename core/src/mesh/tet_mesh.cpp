@@ -160,29 +160,38 @@ TetMesh box_tet_mesh(const Vector3d& min, const Vector3d& max, const std::array<
         mesh.vertices.row(index(i, j, k)) =
             (min.array() + t.array() * (max - min).array()).matrix();
       }
-  // Kuhn split: six tets along paths 000 → e_a → e_a + e_b → 111 over the axis permutations.
+  // Kuhn split: six tets along paths 000 → e_a → e_a + e_b → 111 over the axis permutations, with
+  // each cell mirrored along the axes where its index is odd. Neighbouring cells then share face
+  // diagonals (the mesh stays conforming) while the main diagonals alternate, so the mesh has no
+  // preferred direction (a single diagonal makes a beam bend sideways under a vertical load).
   static constexpr int kPermutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
                                               {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
   mesh.tets.resize(6 * static_cast<Index>(cells[0]) * cells[1] * cells[2], 4);
   Index t = 0;
   for (int k = 0; k < cells[2]; ++k)
     for (int j = 0; j < cells[1]; ++j)
-      for (int i = 0; i < cells[0]; ++i)
+      for (int i = 0; i < cells[0]; ++i) {
+        const std::array<int, 3> cell = {i, j, k};
+        const auto corner_index = [&](const std::array<int, 3>& local) {
+          std::array<int, 3> global;
+          for (int axis = 0; axis < 3; ++axis)
+            global[axis] = cell[axis] + ((cell[axis] & 1) ? 1 - local[axis] : local[axis]);
+          return index(global[0], global[1], global[2]);
+        };
         for (const auto& permutation : kPermutations) {
-          std::array<int, 3> corner = {i, j, k};
+          std::array<int, 3> local = {0, 0, 0};
           int tet[4];
-          tet[0] = index(corner[0], corner[1], corner[2]);
+          tet[0] = corner_index(local);
           for (int step = 0; step < 3; ++step) {
-            ++corner[permutation[step]];
-            tet[step + 1] = index(corner[0], corner[1], corner[2]);
+            local[permutation[step]] = 1;
+            tet[step + 1] = corner_index(local);
           }
-          // Odd permutations give negatively oriented paths: swap to keep all positive.
-          const bool odd = (permutation[0] == 0 && permutation[1] == 2) ||
-                           (permutation[0] == 1 && permutation[1] == 0) ||
-                           (permutation[0] == 2 && permutation[1] == 1);
-          if (odd) std::swap(tet[2], tet[3]);
+          if (tet_signed_volume(vertex(mesh, tet[0]), vertex(mesh, tet[1]), vertex(mesh, tet[2]),
+                                vertex(mesh, tet[3])) < 0.0)
+            std::swap(tet[2], tet[3]);
           mesh.tets.row(t++) << tet[0], tet[1], tet[2], tet[3];
         }
+      }
   return mesh;
 }
 

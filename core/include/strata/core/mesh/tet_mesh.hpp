@@ -49,7 +49,9 @@ std::pair<Vector3d, Vector3d> bounding_box(ConstRef<MatrixX3d> points);
 double mesh_volume(const TetMesh& mesh);
 
 /// A box [min, max] split into cells[0] × cells[1] × cells[2] hexahedral cells, each split into
-/// six tets around its main diagonal (Kuhn/Freudenthal split: conforming, positively oriented).
+/// six tets around its main diagonal (Kuhn/Freudenthal split), each cell mirrored along the axes
+/// where its index is odd so that the diagonals alternate: conforming, positively oriented and
+/// without a preferred direction.
 /// Throws InputError if a cell count is < 1 or the box is empty.
 TetMesh box_tet_mesh(const Vector3d& min, const Vector3d& max, const std::array<int, 3>& cells);
 
