@@ -1,0 +1,31 @@
+#pragma once
+/// \file tree_flatten.hpp
+/// Flattening (OpenVDB LeafManager style): a list of tree nodes — the leaves, or any active cut —
+/// as a plain TetMesh that core's ElasticModel runs on, with the maps back to the tree.
+#include <vector>
+
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/hierarchy/tet_tree.hpp"
+
+namespace strata {
+
+/// A flattened set of tree nodes.
+struct FlatTreeMesh {
+  /// #V × 3 rest positions and #T × 4 positively oriented tets (tree.tet_vertices order). Only
+  /// vertices used by the tets appear, numbered in increasing tree vertex id; when every coarse
+  /// vertex is used, coarse vertex i stays vertex i.
+  TetMesh mesh;
+  std::vector<NodeId> tet_nodes;   ///< #T: the tree node of each tet
+  std::vector<int> tree_vertices;  ///< #V: the tree vertex id of each mesh vertex
+  std::vector<int> mesh_vertices;  ///< tree.vertex_capacity(): mesh vertex of a tree vertex, or −1
+};
+
+/// The given live nodes (in this order) as a mesh. Nodes overlapping each other (a node and its
+/// descendant) are not detected; a cut through the tree (each point covered once) gives a valid
+/// mesh, conforming if no vertex hangs on a coarser neighbour's edge.
+FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes);
+
+/// All leaves (tree.leaves() order) as a mesh.
+FlatTreeMesh flatten_leaves(const TetTree& tree);
+
+}  // namespace strata
