@@ -1,6 +1,6 @@
 #pragma once
 /// \file scene.hpp
-/// A simulation scene as read from a scene file (scene_reference.md documents every key). Plain
+/// A simulation scene as read from a scene file (README.md, "Scene file and CLI reference", documents every key). Plain
 /// data in the core's own types: parsing lives in scene_parser.hpp, running in scene_runner.hpp.
 #include <array>
 #include <filesystem>
