@@ -8,6 +8,20 @@
 #include "strata/hierarchy/red_refinement.hpp"
 
 namespace strata {
+namespace {
+
+// Makes room for `extra` more elements. Growth is proportional to the part beyond the first
+// `fixed` elements (the roots / coarse vertices, sized exactly at construction), at least
+// kMinGrowth: refining a few nodes of a large coarse mesh does not double the coarse storage.
+constexpr std::size_t kMinGrowth = 1024;
+
+template <typename T>
+void reserve_more(std::vector<T>& array, std::size_t fixed, std::size_t extra) {
+  if (array.size() + extra <= array.capacity()) return;
+  array.reserve(array.size() + std::max({extra, kMinGrowth, array.size() - fixed}));
+}
+
+}  // namespace
 
 TetTree::TetTree(const TetMesh& coarse, int max_level) : m_max_level(max_level) {
   if (max_level < 0 || max_level > kMaxSupportedLevel)
@@ -147,6 +161,7 @@ NodeId TetTree::allocate_block() {
   STRATA_VERIFY(m_nodes.size() + 8 <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
                 "node pool exceeds 32-bit ids");
   const auto first = static_cast<NodeId>(m_nodes.size());
+  reserve_more(m_nodes, static_cast<std::size_t>(m_num_roots), 8);
   m_nodes.resize(m_nodes.size() + 8);
   return first;
 }
@@ -162,6 +177,11 @@ int TetTree::midpoint_or_create(int a, int b) {
     STRATA_VERIFY(m_positions.size() < static_cast<std::size_t>(std::numeric_limits<int>::max()),
                   "vertex array exceeds 32-bit ids");
     v = static_cast<int>(m_positions.size());
+    const auto fixed = static_cast<std::size_t>(m_num_coarse_vertices);
+    reserve_more(m_positions, fixed, 1);
+    reserve_more(m_parents, fixed, 1);
+    reserve_more(m_use_counts, fixed, 1);
+    reserve_more(m_vertex_levels, fixed, 1);
     m_positions.emplace_back();
     m_parents.emplace_back();
     m_use_counts.push_back(0);

@@ -15,9 +15,11 @@
 ///   a midpoint to zero (no neighbour still refines that edge), the vertex is freed, its id goes
 ///   to a vertex free list and its edge-map entry is erased. Coarse vertices are never freed.
 ///
-/// Memory follows the nodes that exist: about 32 bytes per node plus ~60 per live vertex (and the
-/// slack of doubling arrays and a hash table at most half full), never anything per potential
-/// node. Ids of live nodes and vertices are stable under refinement and coarsening elsewhere.
+/// Memory follows the nodes that exist, never anything per potential node: the roots and coarse
+/// vertices are stored exactly; beyond them each created node costs 32 bytes and each midpoint
+/// ~37 bytes plus 16–64 bytes of hash table (at most half full). The arrays grow by the size of
+/// their refined part (at least 1024 entries), so the slack is at most that part plus 1024. Ids of
+/// live nodes and vertices are stable under refinement and coarsening elsewhere.
 ///
 /// Lifecycle of an adaptive step (later parts build on this class):
 ///   mark (choose nodes) → refine / coarsen (this class) → rebuild hanging-vertex constraints
