@@ -65,7 +65,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   m_constrained = dirichlet_dof_mask(m_groups, num_vertices);
   m_external = strata::external_forces(m_mesh.vertices, m_boundary, m_vertex_mass, gravity, loads,
                                        tolerance);
-  m_stable_dt = stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material.p_wave_speed());
+  m_stable_dt =
+      stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
   m_limits = default_divergence_limits(m_material, m_diagonal);
   if (m_ground)
     m_ground_stiffness = ground_penalty_stiffness(m_material.youngs_modulus,

@@ -1,30 +1,40 @@
 #include "strata/core/sim/stable_time_step.hpp"
 
-#include <Eigen/Geometry>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <limits>
+#include <cmath>
+
+#include "strata/core/fem/deformation_gradient.hpp"
 
 namespace strata {
 
-double min_tet_altitude(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets) {
-  static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-  double smallest = std::numeric_limits<double>::infinity();
+double max_angular_frequency_bound(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
+                                   const Material& material) {
+  const LameParameters lame = material.lame();
+  double max_gradient_eigenvalue = 0.0;
   for (Index t = 0; t < tets.rows(); ++t) {
-    Vector3d x[4];
+    Matrix3x4d x;
     for (int k = 0; k < 4; ++k)
-      x[k] = positions.row(tets(t, k)).transpose();
-    const double volume = std::abs((x[1] - x[0]).dot((x[2] - x[0]).cross(x[3] - x[0]))) / 6.0;
-    double max_area = 0.0;
-    for (const auto& f : kFaces)
-      max_area = std::max(max_area, 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm());
-    if (max_area > 0.0) smallest = std::min(smallest, 3.0 * volume / max_area);
+      x.col(k) = positions.row(tets(t, k)).transpose();
+    const Matrix3d Dm = edge_matrix(x);
+    if (!(std::abs(Dm.determinant()) > 0.0)) continue;  // degenerate tets are rejected earlier
+    const Eigen::Matrix<double, 4, 3> G = shape_function_gradients(Dm.inverse());
+    const Matrix3d GGt = G.transpose() * G;
+    max_gradient_eigenvalue =
+        std::max(max_gradient_eigenvalue,
+                 Eigen::SelfAdjointEigenSolver<Matrix3d>(GGt, Eigen::EigenvaluesOnly)
+                     .eigenvalues()
+                     .maxCoeff());
   }
-  return smallest;
+  return std::sqrt(4.0 * (3.0 * lame.lambda + 2.0 * lame.mu) * max_gradient_eigenvalue /
+                   material.density);
 }
 
 double stable_time_step_estimate(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
-                                 double p_wave_speed) {
-  return min_tet_altitude(positions, tets) / p_wave_speed;
+                                 const Material& material, Integrator integrator) {
+  const double omega = max_angular_frequency_bound(positions, tets, material);
+  const double stability_interval = integrator == Integrator::rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
+  return stability_interval / omega;
 }
 
 double mean_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets) {

@@ -80,7 +80,8 @@ class Simulation {
   double load_factor() const;
   long step_count() const { return m_steps; }
 
-  /// CFL estimate of the largest stable explicit step [s] (stable_time_step.hpp); reported, never
+  /// Largest stable step of the chosen integrator [s], a guaranteed bound for the problem
+  /// linearised at rest (stable_time_step.hpp); reported, never
   /// applied.
   double stable_dt_estimate() const { return m_stable_dt; }
 

@@ -1,20 +1,30 @@
 #pragma once
 /// \file stable_time_step.hpp
-/// CFL-type estimate of the largest stable step of explicit integrators: the time a P-wave needs
-/// to cross the thinnest element, dt ≈ min_t h_t / c_p, with h_t = 3 V_t / (largest face area of
-/// t) the tet's smallest altitude and c_p = √((λ + 2μ)/ρ). It is an estimate: strata reports it
-/// and never changes dt on its own.
+/// Stability limit of the explicit integrators, from the elements and the material's wave speed.
+///
+/// For the lumped-mass system linearised at rest, the highest angular frequency obeys the element
+/// bound ω_max² ≤ max_t ω_t², and for a linear tet with shape-function gradients G = [∇N_0 … ∇N_3]
+/// (3 × 4) ω_t² ≤ 4 (3λ + 2μ) λ_max(G Gᵀ) / ρ: the strain energy density is at most
+/// ½(3λ + 2μ)‖∇u‖², ‖∇u‖² ≤ λ_max(G Gᵀ) ‖u‖², and each vertex carries ρV/4 of the tet's mass.
+/// A step is then stable for symplectic Euler when ω_max dt ≤ 2 and for RK4 when ω_max dt ≤ 2√2
+/// (its stability interval on the imaginary axis). The bound is a guarantee for the linearised
+/// problem, not a sharp value: on box meshes the true limit is about 1.5× larger. Stiffening under
+/// large deformation can lower the true limit. strata reports it and never changes dt on its own.
 #include "strata/core/common/types.hpp"
+#include "strata/core/fem/material.hpp"
+#include "strata/core/sim/solver_settings.hpp"
 
 namespace strata {
 
-/// Smallest altitude over the tets [m]: min_t 3 V_t / max face area. `positions` #V × 3, `tets`
-/// #T × 4.
-double min_tet_altitude(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets);
+/// Upper bound on ω_max [rad/s] (see above). `positions` #V × 3, `tets` #T × 4.
+double max_angular_frequency_bound(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
+                                   const Material& material);
 
-/// min_tet_altitude / p_wave_speed [s].
+/// Largest step [s] for which `integrator` is stable on the linearised problem at rest:
+/// 2/ω (symplectic Euler), 2√2/ω (RK4). Backward Euler is unconditionally stable; for it the
+/// symplectic Euler value is returned as the reference explicit limit.
 double stable_time_step_estimate(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
-                                 double p_wave_speed);
+                                 const Material& material, Integrator integrator);
 
 /// Mean edge length over the tets' six edges [m] (edges shared by tets counted per tet).
 double mean_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets);
