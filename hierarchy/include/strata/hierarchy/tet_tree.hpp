@@ -25,6 +25,10 @@
 ///   mark (choose nodes) → refine / coarsen (this class) → rebuild hanging-vertex constraints
 ///   (from `vertex_parents` of vertices hanging on coarser neighbours) → flatten the active nodes
 ///   (tree_flatten.hpp) → simulate on the flat TetMesh.
+/// Not thread-safe for editing; const queries may run concurrently. `refine` may grow the pool:
+/// references returned by `node`, `bey_vertices` and `vertex_position` are invalidated by it,
+/// ids are not.
+///
 /// Vertex ids freed by coarsening may be reused by a later refinement: per-vertex simulation
 /// state must be re-initialised for vertices a refinement creates (e.g. ½(x_a + x_b) of the
 /// deformed parents, in order of `vertex_level`).
