@@ -27,7 +27,7 @@ struct TetPartition {
 /// Builds the schedule. `target_chunks` bounds the number of chunks (more chunks: better balance,
 /// more colours).
 TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
-                                 int target_chunks = 64);
+                                 int target_chunks = 256);
 
 /// Runs body(chunk) for every chunk: colours in sequence, chunks of a colour in parallel (TBB).
 void for_each_chunk_colored(const TetPartition& partition, const std::function<void(int)>& body);
