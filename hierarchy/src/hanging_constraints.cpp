@@ -1,0 +1,203 @@
+#include "strata/hierarchy/hanging_constraints.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "strata/core/common/error.hpp"
+#include "strata/hierarchy/red_refinement.hpp"
+
+namespace strata {
+namespace {
+
+constexpr std::array<std::array<int, 3>, 4> kTetFaces = {
+    {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
+
+// Walks the tree vertices on the boundary of one active tet and records those that are vertices of
+// the flattened mesh as hanging on it.
+class BoundaryWalker {
+ public:
+  BoundaryWalker(const TetTree& tree, const FlatTreeMesh& flat, std::vector<NodeId>& host)
+      : m_tree(tree), m_mesh_vertices(flat.mesh_vertices), m_host(host) {}
+
+  void walk(NodeId node) {
+    m_node = node;
+    m_level = m_tree.level(node);
+    const std::array<int, 4>& v = m_tree.bey_vertices(node);
+    for (const auto& e : kTetEdges)
+      walk_edge(v[e[0]], v[e[1]]);
+    for (const auto& f : kTetFaces)
+      walk_face_interior(v[f[0]], v[f[1]], v[f[2]]);
+  }
+
+ private:
+  // Tree vertices on the open segment a–b: its midpoint and, recursively, those of the halves.
+  void walk_edge(int a, int b) {
+    const int m = m_tree.midpoint(a, b);
+    if (m < 0) return;
+    record(m);
+    walk_edge(a, m);
+    walk_edge(m, b);
+  }
+
+  // Tree vertices inside the triangle a, b, c (not on its edges): the face was refined iff all
+  // three edge midpoints exist; then the mid-segments and the four sub-triangles carry them.
+  void walk_face_interior(int a, int b, int c) {
+    const int ab = m_tree.midpoint(a, b);
+    const int ac = m_tree.midpoint(a, c);
+    const int bc = m_tree.midpoint(b, c);
+    if (ab < 0 || ac < 0 || bc < 0) return;
+    walk_edge(ab, ac);
+    walk_edge(ab, bc);
+    walk_edge(ac, bc);
+    walk_face_interior(a, ab, ac);
+    walk_face_interior(b, ab, bc);
+    walk_face_interior(c, ac, bc);
+    walk_face_interior(ab, ac, bc);
+  }
+
+  void record(int tree_vertex) {
+    if (static_cast<std::size_t>(tree_vertex) >= m_mesh_vertices.size()) return;
+    const int v = m_mesh_vertices[tree_vertex];
+    if (v < 0) return;
+    NodeId& host = m_host[v];
+    if (host == kNoNode || m_tree.level(host) > m_level) host = m_node;
+  }
+
+  const TetTree& m_tree;
+  const std::vector<int>& m_mesh_vertices;
+  std::vector<NodeId>& m_host;
+  NodeId m_node = kNoNode;
+  int m_level = 0;
+};
+
+}  // namespace
+
+std::vector<HangingVertex> find_hanging_vertices(const TetTree& tree, const FlatTreeMesh& flat) {
+  const auto num_vertices = static_cast<std::size_t>(flat.mesh.vertices.rows());
+  STRATA_VERIFY(flat.tree_vertices.size() == num_vertices,
+                "find_hanging_vertices: flat mesh and its vertex map disagree");
+  std::vector<NodeId> host(num_vertices, kNoNode);
+  BoundaryWalker walker(tree, flat, host);
+  for (const NodeId n : flat.tet_nodes)
+    walker.walk(n);
+
+  std::vector<HangingVertex> hanging;
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    if (host[v] == kNoNode) continue;
+    const int tree_vertex = flat.tree_vertices[v];
+    const std::array<int, 2>& parents = tree.vertex_parents(tree_vertex);
+    HangingVertex h;
+    h.vertex = static_cast<int>(v);
+    for (int i = 0; i < 2; ++i) {
+      // A refined node's corners are corners of its active descendants, so parents are in the
+      // mesh whenever the cut is valid.
+      STRATA_VERIFY(parents[i] >= 0 && flat.mesh_vertices[parents[i]] >= 0,
+                    "find_hanging_vertices: a hanging vertex's parent is not in the mesh "
+                    "(the nodes are not a valid cut)");
+      h.parents[i] = flat.mesh_vertices[parents[i]];
+    }
+    h.host = host[v];
+    h.host_level = tree.level(host[v]);
+    hanging.push_back(h);
+  }
+  std::sort(hanging.begin(), hanging.end(), [&](const HangingVertex& x, const HangingVertex& y) {
+    const int lx = tree.vertex_level(flat.tree_vertices[x.vertex]);
+    const int ly = tree.vertex_level(flat.tree_vertices[y.vertex]);
+    return lx != ly ? lx < ly : x.vertex < y.vertex;
+  });
+  return hanging;
+}
+
+HangingConstraints::HangingConstraints(const TetTree& tree, const FlatTreeMesh& flat)
+    : m_hanging(find_hanging_vertices(tree, flat)) {
+  const auto num_vertices = static_cast<std::size_t>(flat.mesh.vertices.rows());
+  m_free_index.assign(num_vertices, 0);
+  for (const HangingVertex& h : m_hanging)
+    m_free_index[h.vertex] = -1;
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    if (m_free_index[v] < 0) continue;
+    m_free_index[v] = static_cast<int>(m_free_vertices.size());
+    m_free_vertices.push_back(static_cast<int>(v));
+  }
+
+  // Rows of C as sparse (free index, weight) lists; parents are resolved before their children.
+  using Row = std::vector<std::pair<int, double>>;
+  std::vector<Row> rows(num_vertices);
+  std::vector<int> depth(num_vertices, 0);
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    if (m_free_index[v] >= 0) rows[v] = {{m_free_index[v], 1.0}};
+  for (const HangingVertex& h : m_hanging) {
+    Row merged;
+    for (const int p : h.parents) {
+      STRATA_VERIFY(!rows[p].empty(), "HangingConstraints: parent resolved after its child");
+      for (const auto& [q, w] : rows[p])
+        merged.emplace_back(q, 0.5 * w);
+    }
+    std::sort(merged.begin(), merged.end());
+    Row& row = rows[h.vertex];
+    for (const auto& [q, w] : merged) {
+      if (!row.empty() && row.back().first == q)
+        row.back().second += w;
+      else
+        row.emplace_back(q, w);
+    }
+    depth[h.vertex] = 1 + std::max(depth[h.parents[0]], depth[h.parents[1]]);
+    m_max_chain_depth = std::max(m_max_chain_depth, depth[h.vertex]);
+  }
+
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::size_t v = 0; v < num_vertices; ++v)
+    for (const auto& [q, w] : rows[v])
+      triplets.emplace_back(static_cast<int>(v), q, w);
+  m_C.resize(static_cast<Index>(num_vertices), num_free());
+  m_C.setFromTriplets(triplets.begin(), triplets.end());
+}
+
+SparseMatrixd HangingConstraints::dof_matrix() const {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(3 * static_cast<std::size_t>(m_C.nonZeros()));
+  for (Index q = 0; q < m_C.outerSize(); ++q)
+    for (SparseMatrixd::InnerIterator it(m_C, q); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        triplets.emplace_back(static_cast<int>(3 * it.row() + c), static_cast<int>(3 * q + c),
+                              it.value());
+  SparseMatrixd P(3 * m_C.rows(), 3 * m_C.cols());
+  P.setFromTriplets(triplets.begin(), triplets.end());
+  return P;
+}
+
+VectorXd HangingConstraints::expand(ConstRef<VectorXd> q) const {
+  STRATA_VERIFY(q.size() == 3 * num_free(), "HangingConstraints::expand: q must have 3·#Q entries");
+  const Eigen::Map<const Eigen::Matrix<double, 3, Eigen::Dynamic>> Q(q.data(), 3, num_free());
+  VectorXd x(3 * num_vertices());
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>> X(x.data(), 3, num_vertices());
+  X = Q * m_C.transpose();
+  return x;
+}
+
+VectorXd HangingConstraints::reduce(ConstRef<VectorXd> f) const {
+  STRATA_VERIFY(f.size() == 3 * num_vertices(),
+                "HangingConstraints::reduce: f must have 3·#V entries");
+  const Eigen::Map<const Eigen::Matrix<double, 3, Eigen::Dynamic>> F(f.data(), 3, num_vertices());
+  VectorXd fq(3 * num_free());
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>> FQ(fq.data(), 3, num_free());
+  FQ = F * m_C;
+  return fq;
+}
+
+VectorXd HangingConstraints::reduce_scalar(ConstRef<VectorXd> s) const {
+  STRATA_VERIFY(s.size() == num_vertices(),
+                "HangingConstraints::reduce_scalar: s must have #V entries");
+  return m_C.transpose() * s;
+}
+
+VectorXd HangingConstraints::restrict_to_free(ConstRef<VectorXd> x) const {
+  STRATA_VERIFY(x.size() == 3 * num_vertices(),
+                "HangingConstraints::restrict_to_free: x must have 3·#V entries");
+  VectorXd q(3 * num_free());
+  for (std::size_t i = 0; i < m_free_vertices.size(); ++i)
+    q.segment<3>(3 * static_cast<Index>(i)) = x.segment<3>(3 * m_free_vertices[i]);
+  return q;
+}
+
+}  // namespace strata
