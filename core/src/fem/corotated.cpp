@@ -1,31 +1,10 @@
 #include "strata/core/fem/corotated.hpp"
 
-#include <Eigen/SVD>
 #include <cmath>
 
 namespace strata {
 
 namespace {
-
-/// SVD F = U diag(σ) Vᵀ with U, V proper rotations; an inversion shows as σ₂ < 0 (Irving 2004).
-struct RotationVariantSvd {
-  Matrix3d U, V;
-  Vector3d sigma;
-};
-
-RotationVariantSvd rotation_variant_svd(const Matrix3d& F) {
-  Eigen::JacobiSVD<Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  RotationVariantSvd result{svd.matrixU(), svd.matrixV(), svd.singularValues()};
-  if (result.U.determinant() < 0.0) {
-    result.U.col(2) *= -1.0;
-    result.sigma[2] *= -1.0;
-  }
-  if (result.V.determinant() < 0.0) {
-    result.V.col(2) *= -1.0;
-    result.sigma[2] *= -1.0;
-  }
-  return result;
-}
 
 /// Division that keeps its sign and stays finite when the denominator vanishes.
 double safe_divide(double numerator, double denominator) {
@@ -35,11 +14,6 @@ double safe_divide(double numerator, double denominator) {
 }
 
 }  // namespace
-
-Matrix3d polar_rotation(const Matrix3d& F) {
-  const RotationVariantSvd svd = rotation_variant_svd(F);
-  return svd.U * svd.V.transpose();
-}
 
 double psi_corotated(const Matrix3d& F, const LameParameters& lame) {
   const Vector3d sigma = rotation_variant_svd(F).sigma;

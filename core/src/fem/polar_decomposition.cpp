@@ -1,0 +1,122 @@
+#include "strata/core/fem/polar_decomposition.hpp"
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace strata {
+
+namespace {
+
+/// Pairs whose columns satisfy |b_p · b_q| ≤ kOrthogonality ‖b_p‖ ‖b_q‖ count as orthogonal.
+constexpr double kOrthogonality = 1e-15;
+constexpr int kMaxSweeps = 12;
+
+/// One Jacobi rotation of columns p, q of B (and of V) making them orthogonal.
+/// Returns false when the pair already is (then nothing changes).
+inline bool orthogonalize_pair(Matrix3d& B, Matrix3d& V, int p, int q) {
+  const double alpha = B.col(p).squaredNorm();
+  const double beta = B.col(q).squaredNorm();
+  const double gamma = B.col(p).dot(B.col(q));
+  if (std::abs(gamma) <= kOrthogonality * std::sqrt(alpha * beta)) return false;
+  // cot 2θ = ζ; t = tan θ is the smaller root of t² + 2ζt − 1 = 0.
+  const double zeta = (beta - alpha) / (2.0 * gamma);
+  const double t = std::abs(zeta) > 1e150
+                       ? 0.5 / zeta
+                       : std::copysign(1.0, zeta) / (std::abs(zeta) + std::sqrt(1.0 + zeta * zeta));
+  const double c = 1.0 / std::sqrt(1.0 + t * t);
+  const double s = c * t;
+  for (int r = 0; r < 3; ++r) {
+    const double bp = B(r, p), bq = B(r, q);
+    B(r, p) = c * bp - s * bq;
+    B(r, q) = s * bp + c * bq;
+    const double vp = V(r, p), vq = V(r, q);
+    V(r, p) = c * vp - s * vq;
+    V(r, q) = s * vp + c * vq;
+  }
+  return true;
+}
+
+/// A unit vector orthogonal to the unit vector u.
+inline Vector3d any_orthogonal_unit(const Vector3d& u) {
+  Index axis = 0;
+  u.cwiseAbs().minCoeff(&axis);
+  return u.cross(Vector3d::Unit(axis)).normalized();
+}
+
+inline void swap_columns(Matrix3d& B, Matrix3d& V, Vector3d& squared_norms, int i, int j) {
+  B.col(i).swap(B.col(j));
+  V.col(i).swap(V.col(j));
+  std::swap(squared_norms[i], squared_norms[j]);
+}
+
+}  // namespace
+
+RotationVariantSvd rotation_variant_svd(const Matrix3d& F) {
+  // Power-of-two prescaling keeps squared norms finite; exact, so typical inputs are untouched.
+  const double largest = F.cwiseAbs().maxCoeff();
+  int exponent = 0;
+  if (!(largest >= 1e-100 && largest <= 1e100)) {
+    if (largest == 0.0) return {Matrix3d::Identity(), Vector3d::Zero(), Matrix3d::Identity()};
+    if (!std::isfinite(largest)) {  // NaN / inf propagate instead of passing for a rest state
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      return {Matrix3d::Constant(nan), Vector3d::Constant(nan), Matrix3d::Constant(nan)};
+    }
+    std::frexp(largest, &exponent);
+  }
+  Matrix3d B = exponent == 0 ? F : Matrix3d(std::ldexp(1.0, -exponent) * F);
+  Matrix3d V = Matrix3d::Identity();
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    bool rotated = orthogonalize_pair(B, V, 0, 1);
+    rotated |= orthogonalize_pair(B, V, 0, 2);
+    rotated |= orthogonalize_pair(B, V, 1, 2);
+    if (!rotated) break;
+  }
+
+  // Sort columns by length, descending; every swap flips det V.
+  Vector3d squared_norms = B.colwise().squaredNorm().transpose();
+  bool reflected = false;
+  if (squared_norms[0] < squared_norms[1]) {
+    swap_columns(B, V, squared_norms, 0, 1);
+    reflected = !reflected;
+  }
+  if (squared_norms[1] < squared_norms[2]) {
+    swap_columns(B, V, squared_norms, 1, 2);
+    reflected = !reflected;
+  }
+  if (squared_norms[0] < squared_norms[1]) {
+    swap_columns(B, V, squared_norms, 0, 1);
+    reflected = !reflected;
+  }
+  if (reflected) {
+    V.col(2) = -V.col(2);
+    B.col(2) = -B.col(2);
+  }
+
+  RotationVariantSvd svd;
+  svd.V = V;
+  if (squared_norms[0] == 0.0) {
+    svd.U.setIdentity();
+    svd.sigma.setZero();
+    return svd;
+  }
+  const Vector3d u0 = B.col(0) / std::sqrt(squared_norms[0]);
+  const Vector3d b1 = B.col(1) - u0.dot(B.col(1)) * u0;
+  const double b1_norm = b1.norm();
+  const Vector3d u1 = b1_norm > 0.0 ? Vector3d(b1 / b1_norm) : any_orthogonal_unit(u0);
+  svd.U.col(0) = u0;
+  svd.U.col(1) = u1;
+  svd.U.col(2) = u0.cross(u1);
+  const double scale = std::ldexp(1.0, exponent);
+  svd.sigma[0] = scale * std::sqrt(squared_norms[0]);
+  svd.sigma[1] = scale * std::sqrt(squared_norms[1]);
+  svd.sigma[2] = std::copysign(scale * std::sqrt(squared_norms[2]), svd.U.col(2).dot(B.col(2)));
+  return svd;
+}
+
+Matrix3d polar_rotation(const Matrix3d& F) {
+  const RotationVariantSvd svd = rotation_variant_svd(F);
+  return svd.U * svd.V.transpose();
+}
+
+}  // namespace strata
