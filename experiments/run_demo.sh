@@ -43,7 +43,7 @@ if [[ -f "${probes}" ]]; then
         split(rows[i], c, ",")
         if (c[1] != last) continue
         m = sqrt(c[6] * c[6] + c[7] * c[7] + c[8] * c[8])
-        printf "  probe %s at (%s, %s, %s), t = %s s: u = (%.6g, %.6g, %.6g) m, |u| = %.6g m\n",
+        printf "  probe %s at (%s, %s, %s), time or load factor %s: u = (%.6g, %.6g, %.6g) m, |u| = %.6g m\n",
                c[2], c[3], c[4], c[5], c[1], c[6], c[7], c[8], m
         if (m > best) { best = m; tip = c[2]; uz = c[8] }
       }
