@@ -12,8 +12,22 @@ namespace {
 constexpr std::array<std::array<int, 3>, 4> kTetFaces = {
     {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
 
-// Walks the tree vertices on the boundary of one active tet and records those that are vertices of
-// the flattened mesh as hanging on it.
+// P = C ⊗ I₃ in the vertex-major DOF layout.
+SparseMatrixd kronecker_identity3(const SparseMatrixd& C) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(3 * static_cast<std::size_t>(C.nonZeros()));
+  for (Index q = 0; q < C.outerSize(); ++q)
+    for (SparseMatrixd::InnerIterator it(C, q); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        triplets.emplace_back(static_cast<int>(3 * it.row() + c), static_cast<int>(3 * q + c),
+                              it.value());
+  SparseMatrixd P(3 * C.rows(), 3 * C.cols());
+  P.setFromTriplets(triplets.begin(), triplets.end());
+  return P;
+}
+
+// Walks the mesh vertices on the boundary of one active tet (not its corners) and records them as
+// hanging on it.
 class BoundaryWalker {
  public:
   BoundaryWalker(const TetTree& tree, const FlatTreeMesh& flat, std::vector<NodeId>& host)
@@ -30,22 +44,25 @@ class BoundaryWalker {
   }
 
  private:
-  // Tree vertices on the open segment a–b: its midpoint and, recursively, those of the halves.
+  // Mesh vertices on the open segment a–b: its midpoint and, recursively, those of the halves.
+  // A mesh vertex's parents are mesh vertices, so the walk stops at a midpoint outside the mesh.
   void walk_edge(int a, int b) {
     const int m = m_tree.midpoint(a, b);
-    if (m < 0) return;
+    if (!is_mesh_vertex(m)) return;
     record(m);
     walk_edge(a, m);
     walk_edge(m, b);
   }
 
-  // Tree vertices inside the triangle a, b, c (not on its edges): the face was refined iff all
-  // three edge midpoints exist; then the mid-segments and the four sub-triangles carry them.
+  // Mesh vertices inside the triangle a, b, c (not on its edges). The face was refined iff all
+  // three edge midpoints exist; every vertex inside descends (through parents) from one of them,
+  // so the walk stops when none of them is a mesh vertex.
   void walk_face_interior(int a, int b, int c) {
     const int ab = m_tree.midpoint(a, b);
     const int ac = m_tree.midpoint(a, c);
     const int bc = m_tree.midpoint(b, c);
     if (ab < 0 || ac < 0 || bc < 0) return;
+    if (!is_mesh_vertex(ab) && !is_mesh_vertex(ac) && !is_mesh_vertex(bc)) return;
     walk_edge(ab, ac);
     walk_edge(ab, bc);
     walk_edge(ac, bc);
@@ -55,11 +72,13 @@ class BoundaryWalker {
     walk_face_interior(ab, ac, bc);
   }
 
+  bool is_mesh_vertex(int tree_vertex) const {
+    return tree_vertex >= 0 && static_cast<std::size_t>(tree_vertex) < m_mesh_vertices.size() &&
+           m_mesh_vertices[tree_vertex] >= 0;
+  }
+
   void record(int tree_vertex) {
-    if (static_cast<std::size_t>(tree_vertex) >= m_mesh_vertices.size()) return;
-    const int v = m_mesh_vertices[tree_vertex];
-    if (v < 0) return;
-    NodeId& host = m_host[v];
+    NodeId& host = m_host[m_mesh_vertices[tree_vertex]];
     if (host == kNoNode || m_tree.level(host) > m_level) host = m_node;
   }
 
@@ -151,19 +170,13 @@ HangingConstraints::HangingConstraints(const TetTree& tree, const FlatTreeMesh& 
       triplets.emplace_back(static_cast<int>(v), q, w);
   m_C.resize(static_cast<Index>(num_vertices), num_free());
   m_C.setFromTriplets(triplets.begin(), triplets.end());
+  m_P = kronecker_identity3(m_C);
 }
 
-SparseMatrixd HangingConstraints::dof_matrix() const {
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(3 * static_cast<std::size_t>(m_C.nonZeros()));
-  for (Index q = 0; q < m_C.outerSize(); ++q)
-    for (SparseMatrixd::InnerIterator it(m_C, q); it; ++it)
-      for (int c = 0; c < 3; ++c)
-        triplets.emplace_back(static_cast<int>(3 * it.row() + c), static_cast<int>(3 * q + c),
-                              it.value());
-  SparseMatrixd P(3 * m_C.rows(), 3 * m_C.cols());
-  P.setFromTriplets(triplets.begin(), triplets.end());
-  return P;
+SparseMatrixd HangingConstraints::reduce_matrix(const SparseMatrixd& K) const {
+  STRATA_VERIFY(K.rows() == 3 * num_vertices() && K.cols() == 3 * num_vertices(),
+                "HangingConstraints::reduce_matrix: K must be 3·#V square");
+  return SparseMatrixd(m_P.transpose() * K * m_P);
 }
 
 VectorXd HangingConstraints::expand(ConstRef<VectorXd> q) const {
@@ -198,6 +211,12 @@ VectorXd HangingConstraints::restrict_to_free(ConstRef<VectorXd> x) const {
   for (std::size_t i = 0; i < m_free_vertices.size(); ++i)
     q.segment<3>(3 * static_cast<Index>(i)) = x.segment<3>(3 * m_free_vertices[i]);
   return q;
+}
+
+ConstrainedCut flatten_cut(const ActiveCut& cut) {
+  FlatTreeMesh flat = flatten_nodes(cut.tree(), cut.nodes());
+  HangingConstraints constraints(cut.tree(), flat);
+  return {std::move(flat), std::move(constraints)};
 }
 
 }  // namespace strata

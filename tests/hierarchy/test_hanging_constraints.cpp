@@ -15,6 +15,7 @@
 #include "strata/hierarchy/active_cut.hpp"
 #include "strata/hierarchy/cut_balance.hpp"
 #include "strata/hierarchy/hanging_constraints.hpp"
+#include "strata/hierarchy/uniform_refinement.hpp"
 
 namespace strata {
 namespace {
@@ -26,15 +27,17 @@ TetMesh test_box() {
   return box_tet_mesh(kBoxMin, kBoxMax, {2, 2, 2});
 }
 
-// Roots 0 and 21 refined to level 1, three of their children to level 2: level-2 tets touch
-// level-0 tets (chains of hanging vertices).
+// Root 0 refined to level 1 and two of its children to level 2; root 21 refined to level 2 in
+// full. Level-2 tets touch level-0 tets: chains of hanging vertices, vertices a quarter along
+// coarse edges and inside coarse faces (not on any active edge).
 ActiveCut unbalanced_cut(TetTree& tree) {
   ActiveCut cut(tree);
   const NodeId a = cut.refine(0);
   cut.refine(a + 1);
   cut.refine(a + 6);
   const NodeId b = cut.refine(21);
-  cut.refine(b + 4);
+  for (int k = 0; k < 8; ++k)
+    cut.refine(b + k);
   return cut;
 }
 
@@ -44,15 +47,10 @@ ActiveCut balanced_cut(TetTree& tree) {
   return cut;
 }
 
-struct Constrained {
-  FlatTreeMesh flat;
-  HangingConstraints constraints;
-};
+using Constrained = ConstrainedCut;
 
 Constrained constrain(const ActiveCut& cut) {
-  FlatTreeMesh flat = flatten_nodes(cut.tree(), cut.nodes());
-  HangingConstraints constraints(cut.tree(), flat);
-  return {std::move(flat), std::move(constraints)};
+  return flatten_cut(cut);
 }
 
 bool on_box_boundary(const Vector3d& x) {
@@ -123,6 +121,17 @@ TEST(HangingConstraints, DetectionMatchesPointLocation) {
   }
   // Level-2 tets next to level-0 tets make vertices a quarter along coarse edges: chains.
   EXPECT_GE(constrain(unbalanced_cut(tree)).constraints.max_chain_depth(), 2);
+}
+
+TEST(HangingConstraints, NoneOnUniformCutsOfADeeperTree) {
+  TetTree tree(test_box(), 2);
+  refine_uniformly(tree, 2);
+  for (const ActiveCut& cut : {ActiveCut(tree), ActiveCut::uniform(tree, 1)}) {
+    const Constrained c = constrain(cut);
+    EXPECT_EQ(c.constraints.num_hanging(), 0);
+    EXPECT_EQ(c.constraints.max_chain_depth(), 0);
+    EXPECT_EQ(c.constraints.num_free(), c.flat.mesh.vertices.rows());
+  }
 }
 
 TEST(HangingConstraints, EmbeddingStructure) {
@@ -296,9 +305,10 @@ void check_patch(const ActiveCut& cut, const Matrix3d& A) {
   Vector6d expected;
   expected << E(0, 0), E(1, 1), E(2, 2), E(0, 1), E(1, 2), E(0, 2);
   const TetFields fields = model.tet_fields(x);
+  // E = ½(FᵀF − I) cancels against I: its round-off floor is absolute, a few ε (|F| ≈ 1).
   for (Index t = 0; t < fields.green_strain.rows(); ++t)
     EXPECT_LE((fields.green_strain.row(t).transpose() - expected).norm(),
-              1e-12 * expected.norm() + 1e-15)
+              1e-12 * expected.norm() + 1e-14)
         << "tet " << t;
 
   VectorXd f;
@@ -370,6 +380,19 @@ TEST(HangingConstraints, ReducedForceIsTheGradientOfTheReducedEnergy) {
   const double slope =
       (model.energy(hc.expand(q + h * d)) - model.energy(hc.expand(q - h * d))) / (2.0 * h);
   EXPECT_NEAR(slope, -fq.dot(d), 1e-6 * std::abs(slope));
+
+  // K_q = Pᵀ K P is the derivative of −f_q.
+  SparseMatrixd K;
+  model.stiffness(hc.expand(q), K, false);
+  const SparseMatrixd Kq = hc.reduce_matrix(K);
+  ASSERT_EQ(Kq.rows(), 3 * hc.num_free());
+  VectorXd f_plus;
+  VectorXd f_minus;
+  model.forces(hc.expand(q + h * d), f_plus);
+  model.forces(hc.expand(q - h * d), f_minus);
+  const VectorXd fd = -(hc.reduce(f_plus) - hc.reduce(f_minus)) / (2.0 * h);
+  const VectorXd Kd = Kq * d;
+  EXPECT_LE((fd - Kd).norm(), 1e-6 * Kd.norm());
 }
 
 TEST(HangingConstraints, MassIsConservedOnEveryCut) {

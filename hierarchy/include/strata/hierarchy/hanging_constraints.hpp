@@ -18,17 +18,20 @@
 /// exactly). For the 3·#V vertex-major DOF vectors of core this is C ⊗ I₃ (`dof_matrix`).
 ///
 /// Reduced quantities of the constrained system (so core's integrators and static solver can run on
-/// q unchanged): forces f_q = Cᵀ f, stiffness K_q = Cᵀ K C (use `dof_matrix`), lumped masses
-/// m_q = Cᵀ m (= row sums of Cᵀ diag(m) C since C·1 = 1: total mass is kept, no entry negative).
+/// q unchanged): forces f_q = Cᵀ f, stiffness K_q = Pᵀ K P with P = C ⊗ I₃ (`reduce_matrix`),
+/// lumped masses m_q = Cᵀ m (= row sums of Cᵀ diag(m) C since C·1 = 1: total mass is kept, no entry
+/// negative).
 ///
 /// Detection (`find_hanging_vertices`): for each active tet, walk the tree vertices on its edges
 /// (edge midpoints, recursively along the halves) and inside its faces (midpoints of the face's
 /// mid-segments, recursively in the four sub-triangles) through TetTree::midpoint; every one that
-/// is a vertex of the flattened mesh hangs on that tet. Cost: the number of tree vertices on the
-/// active tets' boundaries; works for any valid cut (no 2:1 balance needed).
+/// is a vertex of the flattened mesh hangs on that tet. Since the parents of a mesh vertex are mesh
+/// vertices, the walk stops where no mesh vertex can follow: the cost is O(#active + #hanging),
+/// independent of tree nodes below the cut. Works for any valid cut (no 2:1 balance needed).
 #include <array>
 #include <vector>
 
+#include "strata/hierarchy/active_cut.hpp"
 #include "strata/hierarchy/tree_flatten.hpp"
 
 namespace strata {
@@ -66,13 +69,15 @@ class HangingConstraints {
 
   /// Scalar C, #V × #Q, column-major.
   const SparseMatrixd& matrix() const { return m_C; }
-  /// C ⊗ I₃, 3·#V × 3·#Q, for the vertex-major DOF layout (e.g. K_q = Pᵀ K P).
-  SparseMatrixd dof_matrix() const;
+  /// P = C ⊗ I₃, 3·#V × 3·#Q, for the vertex-major DOF layout.
+  const SparseMatrixd& dof_matrix() const { return m_P; }
 
   /// x = C q per coordinate: 3·#Q → 3·#V (positions, velocities, displacements).
   VectorXd expand(ConstRef<VectorXd> q) const;
   /// f_q = Cᵀ f per coordinate: 3·#V → 3·#Q (forces; energy-consistent since Ψ_q(q) = Ψ(Cq)).
   VectorXd reduce(ConstRef<VectorXd> f) const;
+  /// K_q = Pᵀ K P: 3·#V square → 3·#Q square (stiffness, consistent mass, damping).
+  SparseMatrixd reduce_matrix(const SparseMatrixd& K) const;
   /// Cᵀ s for one scalar per vertex: #V → #Q (lumped masses).
   VectorXd reduce_scalar(ConstRef<VectorXd> s) const;
   /// The free vertices' entries of a 3·#V vector: 3·#Q (e.g. q from rest positions).
@@ -84,6 +89,16 @@ class HangingConstraints {
   std::vector<HangingVertex> m_hanging;
   int m_max_chain_depth = 0;
   SparseMatrixd m_C;
+  SparseMatrixd m_P;
 };
+
+/// A flattened cut with its constraints: the simulation mesh (#V vertices, flat.mesh) and x = C q.
+struct ConstrainedCut {
+  FlatTreeMesh flat;
+  HangingConstraints constraints;
+};
+
+/// One-shot: `flatten_nodes(cut.tree(), cut.nodes())` and its HangingConstraints.
+ConstrainedCut flatten_cut(const ActiveCut& cut);
 
 }  // namespace strata
