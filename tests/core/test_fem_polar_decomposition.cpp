@@ -135,21 +135,24 @@ void check_decomposition(const Matrix3d& F, MaxErrors& errors) {
   errors.sigma = std::max(errors.sigma, sigma_error);
 
   // R is unique iff every σᵢ + σⱼ ≠ 0 (i ≠ j); its condition number is σ₀ / min(σᵢ + σⱼ).
-  const Matrix3d R = polar_rotation(F);
-  EXPECT_LT((R - svd.U * svd.V.transpose()).norm(), 1e-15) << F;
+  // Both the SVD's U Vᵀ and polar_rotation (Newton fast path for det F > 0) are checked.
   const double pair_sum = std::min(
       {ref.sigma[0] + ref.sigma[1], ref.sigma[0] + ref.sigma[2], ref.sigma[1] + ref.sigma[2]});
-  if (pair_sum > 1e-6 * scale) {
-    const double rotation_error = (R - ref.U * ref.V.transpose()).norm() * pair_sum / scale;
-    EXPECT_LT(rotation_error, 1e-14) << F;
-    errors.rotation = std::max(errors.rotation, rotation_error);
+  for (const Matrix3d& R : {Matrix3d(svd.U * svd.V.transpose()), polar_rotation(F)}) {
+    EXPECT_LT((R.transpose() * R - Matrix3d::Identity()).norm(), 1e-14) << F;
+    EXPECT_GT(R.determinant(), 0.0) << F;
+    if (pair_sum > 1e-6 * scale) {
+      const double rotation_error = (R - ref.U * ref.V.transpose()).norm() * pair_sum / scale;
+      EXPECT_LT(rotation_error, 1e-14) << F;
+      errors.rotation = std::max(errors.rotation, rotation_error);
+    }
+    // Whether unique or not: RᵀF = S is symmetric with trace Σσ.
+    const Matrix3d S = R.transpose() * F;
+    const double symmetry = (S - S.transpose()).norm() / scale;
+    EXPECT_LT(symmetry, 1e-14) << F;
+    EXPECT_NEAR(S.trace(), s.sum(), 1e-14 * scale) << F;
+    errors.symmetry = std::max(errors.symmetry, symmetry);
   }
-  // Whether unique or not: RᵀF = S is symmetric with trace Σσ.
-  const Matrix3d S = R.transpose() * F;
-  const double symmetry = (S - S.transpose()).norm() / scale;
-  EXPECT_LT(symmetry, 1e-14) << F;
-  EXPECT_NEAR(S.trace(), s.sum(), 1e-14 * scale) << F;
-  errors.symmetry = std::max(errors.symmetry, symmetry);
 }
 
 TEST(PolarDecomposition, PropertiesAndAgreementWithJacobiSvdOn10kMatrices) {

@@ -16,16 +16,15 @@ double safe_divide(double numerator, double denominator) {
 }  // namespace
 
 double psi_corotated(const Matrix3d& F, const LameParameters& lame) {
-  const Vector3d sigma = rotation_variant_svd(F).sigma;
-  const double trace_term = sigma.sum() - 3.0;
-  return lame.mu * (sigma.array() - 1.0).square().sum() +
-         0.5 * lame.lambda * trace_term * trace_term;
+  const Matrix3d R = polar_rotation(F);
+  const double trace_term = R.cwiseProduct(F).sum() - 3.0;  // tr(RᵀF) − 3 = Σσ − 3
+  return lame.mu * (F - R).squaredNorm() + 0.5 * lame.lambda * trace_term * trace_term;
 }
 
 Matrix3d dpsi_corotated_dF(const Matrix3d& F, const LameParameters& lame) {
-  const RotationVariantSvd svd = rotation_variant_svd(F);
-  const Matrix3d R = svd.U * svd.V.transpose();
-  return 2.0 * lame.mu * (F - R) + lame.lambda * (svd.sigma.sum() - 3.0) * R;
+  const Matrix3d R = polar_rotation(F);
+  const double trace_term = R.cwiseProduct(F).sum() - 3.0;
+  return 2.0 * lame.mu * (F - R) + lame.lambda * trace_term * R;
 }
 
 Matrix9d d2psi_corotated_dF2(const Matrix3d& F, const LameParameters& lame) {

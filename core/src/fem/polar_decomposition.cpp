@@ -114,7 +114,54 @@ RotationVariantSvd rotation_variant_svd(const Matrix3d& F) {
   return svd;
 }
 
+namespace {
+
+/// Fast path for det F > 0: scaled Newton iteration X ← (γX + X⁻ᵀ/γ)/2, X₀ = F (Higham 1986,
+/// "Computing the polar decomposition — with applications"). Returns false, leaving R untouched,
+/// for inverted, nearly singular or extremely scaled F, and when it does not converge.
+bool newton_polar_rotation(const Matrix3d& F, Matrix3d& R) {
+  // Nearly flat F (det F < kMinVolumeRatio · (‖F‖²_F / 3)^{3/2}) goes to the SVD instead.
+  constexpr double kMinVolumeRatio = 1e-6;
+  constexpr int kMaxIterations = 12;
+  const double mean_square = F.squaredNorm() / 3.0;
+  if (!(mean_square >= 1e-200 && mean_square <= 1e200)) return false;
+  Matrix3d X = F;
+  double change = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    Matrix3d cofactor;
+    cofactor.col(0) = X.col(1).cross(X.col(2));
+    cofactor.col(1) = X.col(2).cross(X.col(0));
+    cofactor.col(2) = X.col(0).cross(X.col(1));
+    const double det = X.col(0).dot(cofactor.col(0));
+    if (iteration == 0 && !(det >= kMinVolumeRatio * mean_square * std::sqrt(mean_square)))
+      return false;
+    const Matrix3d inverse_transpose = (1.0 / det) * cofactor;
+    // Frobenius scaling γ = (‖X⁻¹‖/‖X‖)^{1/2} while X is far from orthogonal in size or shape
+    // (γ⁴ outside [¼, 4]); checked only at the start and after large steps, since near
+    // convergence unscaled steps keep the quadratic rate.
+    double gamma = 1.0;
+    if (change > 1e-2) {
+      const double inverse_norm = inverse_transpose.squaredNorm(), norm = X.squaredNorm();
+      if (!(inverse_norm > 0.25 * norm && inverse_norm < 4.0 * norm))
+        gamma = std::sqrt(std::sqrt(inverse_norm / norm));
+    }
+    const Matrix3d next = (0.5 * gamma) * X + (0.5 / gamma) * inverse_transpose;
+    change = (next - X).squaredNorm();
+    X = next;
+    // Quadratic convergence: the error after a step of size ‖ΔX‖ ≤ 1e-7 is about ‖ΔX‖²/2 ≤ 5e-15.
+    if (change <= 1e-14) {
+      R = X;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 Matrix3d polar_rotation(const Matrix3d& F) {
+  Matrix3d R;
+  if (newton_polar_rotation(F, R)) return R;
   const RotationVariantSvd svd = rotation_variant_svd(F);
   return svd.U * svd.V.transpose();
 }
