@@ -1,5 +1,6 @@
 #include "strata/core/fem/polar_decomposition.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -12,20 +13,32 @@ namespace {
 constexpr double kOrthogonality = 1e-15;
 constexpr int kMaxSweeps = 12;
 
-/// One Jacobi rotation of columns p, q of B (and of V) making them orthogonal.
-/// Returns false when the pair already is (then nothing changes).
-inline bool orthogonalize_pair(Matrix3d& B, Matrix3d& V, int p, int q) {
+/// One Jacobi rotation of columns p, q of B (and of V) making them orthogonal. Returns |sin θ| of
+/// the rotation angle, 0 when the pair already is orthogonal (then nothing changes).
+inline double orthogonalize_pair(Matrix3d& B, Matrix3d& V, int p, int q) {
   const double alpha = B.col(p).squaredNorm();
   const double beta = B.col(q).squaredNorm();
   const double gamma = B.col(p).dot(B.col(q));
-  if (std::abs(gamma) <= kOrthogonality * std::sqrt(alpha * beta)) return false;
-  // cot 2θ = ζ; t = tan θ is the smaller root of t² + 2ζt − 1 = 0.
-  const double zeta = (beta - alpha) / (2.0 * gamma);
-  const double t = std::abs(zeta) > 1e150
-                       ? 0.5 / zeta
-                       : std::copysign(1.0, zeta) / (std::abs(zeta) + std::sqrt(1.0 + zeta * zeta));
-  const double c = 1.0 / std::sqrt(1.0 + t * t);
-  const double s = c * t;
+  if (std::abs(gamma) <= kOrthogonality * std::sqrt(alpha * beta)) return 0.0;
+  // cot 2θ = (β − α) / 2γ = d / g; θ is the smaller of the two angles. With h = √(d² + g²) and
+  // k = |d| + h: tan θ = sign(d) g / k, and 1 + tan²θ = 2h / k, so c = k / √(2hk).
+  const double d = beta - alpha, g = 2.0 * gamma;
+  const double h_squared = d * d + g * g;
+  double c, s;
+  if (h_squared > 1e-300) {
+    const double h = std::sqrt(h_squared);
+    const double k = std::abs(d) + h;
+    const double inverse_root = 1.0 / std::sqrt(2.0 * h * k);
+    c = k * inverse_root;
+    s = (d < 0.0 ? -g : g) * inverse_root;
+  } else {  // tiny columns: the same angle from ζ = d / g, safe against underflow
+    const double zeta = d / g;
+    const double t = std::abs(zeta) > 1e150 ? 0.5 / zeta
+                                            : std::copysign(1.0, zeta) /
+                                                  (std::abs(zeta) + std::sqrt(1.0 + zeta * zeta));
+    c = 1.0 / std::sqrt(1.0 + t * t);
+    s = c * t;
+  }
   for (int r = 0; r < 3; ++r) {
     const double bp = B(r, p), bq = B(r, q);
     B(r, p) = c * bp - s * bq;
@@ -34,7 +47,7 @@ inline bool orthogonalize_pair(Matrix3d& B, Matrix3d& V, int p, int q) {
     V(r, p) = c * vp - s * vq;
     V(r, q) = s * vp + c * vq;
   }
-  return true;
+  return std::abs(s);
 }
 
 /// A unit vector orthogonal to the unit vector u.
@@ -66,11 +79,13 @@ RotationVariantSvd rotation_variant_svd(const Matrix3d& F) {
   }
   Matrix3d B = exponent == 0 ? F : Matrix3d(std::ldexp(1.0, -exponent) * F);
   Matrix3d V = Matrix3d::Identity();
+  // A rotation by θ disturbs the other pairs' orthogonality by O(θ · their residual), so after a
+  // sweep whose rotations all had |sin θ| ≤ 1e-8 every pair is orthogonal to ~1e-16.
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    bool rotated = orthogonalize_pair(B, V, 0, 1);
-    rotated |= orthogonalize_pair(B, V, 0, 2);
-    rotated |= orthogonalize_pair(B, V, 1, 2);
-    if (!rotated) break;
+    const double t01 = orthogonalize_pair(B, V, 0, 1);
+    const double t02 = orthogonalize_pair(B, V, 0, 2);
+    const double t12 = orthogonalize_pair(B, V, 1, 2);
+    if (std::max({t01, t02, t12}) <= 1e-8) break;
   }
 
   // Sort columns by length, descending; every swap flips det V.
