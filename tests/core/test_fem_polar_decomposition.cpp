@@ -42,7 +42,7 @@ Matrix3d from_singular_values(std::mt19937& rng, const Vector3d& sigma) {
 }
 
 /// Deformation gradient of kind `kind` (0 … kNumKinds − 1), before scaling.
-constexpr int kNumKinds = 16;
+constexpr int kNumKinds = 18;
 Matrix3d sample_kind(std::mt19937& rng, int kind) {
   std::uniform_real_distribution<double> uniform(0.5, 2.0);
   std::normal_distribution<double> normal;
@@ -87,6 +87,10 @@ Matrix3d sample_kind(std::mt19937& rng, int kind) {
     }
     case 14:  // rank 2, up to round-off of the product
       return from_singular_values(rng, Vector3d(uniform(rng), uniform(rng), 0.0));
+    case 16:  // graded singular values, det > 0 (Newton path with scaling)
+      return from_singular_values(rng, uniform(rng) * Vector3d(1.0, 1e-2, 1e-4));
+    case 17:  // one small singular value, det > 0 (Newton path with scaling)
+      return from_singular_values(rng, Vector3d(uniform(rng), uniform(rng), 1e-5 * uniform(rng)));
     default: {  // rank 2 exactly: third column the sum of the first two
       Matrix3d M = gaussian();
       M.col(2) = M.col(0) + M.col(1);

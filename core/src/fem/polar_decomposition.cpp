@@ -139,7 +139,7 @@ bool newton_polar_rotation(const Matrix3d& F, Matrix3d& R) {
   constexpr double kMinVolumeRatio = 1e-6;
   constexpr int kMaxIterations = 12;
   const double mean_square = F.squaredNorm() / 3.0;
-  if (!(mean_square >= 1e-200 && mean_square <= 1e200)) return false;
+  if (!(mean_square >= 1e-150 && mean_square <= 1e150)) return false;
   Matrix3d X = F;
   double change = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
