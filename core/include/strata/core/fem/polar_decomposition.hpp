@@ -23,7 +23,7 @@
 /// σ to 2e-15 σ₀, RᵀF symmetric to 2e-15 σ₀, and R (both paths) to 7e-15 σ₀ / min_{i<j}(σᵢ + σⱼ),
 /// the conditioning of the polar rotation itself. R is not unique when some σᵢ + σⱼ = 0 (rank ≤ 1,
 /// or a reflection with |σ₁| = |σ₂|); a valid one (proper, RᵀF symmetric) is returned.
-/// Cost (x86-64-v3, F near a rotation): polar_rotation ≈ 80 ns, rotation_variant_svd ≈ 360 ns,
+/// Cost (x86-64-v3, F near a rotation): polar_rotation ≈ 80 ns, rotation_variant_svd ≈ 340 ns,
 /// Eigen::JacobiSVD with full U, V ≈ 630 ns.
 #include "strata/core/common/types.hpp"
 
