@@ -89,10 +89,10 @@ RotationVariantSvd rotation_variant_svd(const Matrix3d& F) {
   // A rotation by θ disturbs the other pairs' orthogonality by O(θ · their residual), so after a
   // sweep whose rotations all had |sin θ| ≤ 1e-8 every pair is orthogonal to ~1e-16.
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    const double t01 = orthogonalize_pair(B, V, 0, 1);
-    const double t02 = orthogonalize_pair(B, V, 0, 2);
-    const double t12 = orthogonalize_pair(B, V, 1, 2);
-    if (std::max({t01, t02, t12}) <= 1e-8) break;
+    const double sin01 = orthogonalize_pair(B, V, 0, 1);
+    const double sin02 = orthogonalize_pair(B, V, 0, 2);
+    const double sin12 = orthogonalize_pair(B, V, 1, 2);
+    if (std::max({sin01, sin02, sin12}) <= 1e-8) break;
   }
 
   // Sort columns by length, descending; every swap flips det V.
