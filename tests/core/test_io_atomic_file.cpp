@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/io/mesh_io.hpp"
@@ -17,31 +18,9 @@ namespace strata {
 namespace {
 
 namespace fs = std::filesystem;
-
-class ScratchDir {
- public:
-  explicit ScratchDir(const std::string& tag)
-      : m_path(fs::temp_directory_path() / ("strata_" + tag + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(m_path);
-    fs::create_directories(m_path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(m_path, ignored);
-  }
-  const fs::path& path() const { return m_path; }
-  fs::path operator/(const std::string& name) const { return m_path / name; }
-
- private:
-  fs::path m_path;
-};
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
-}
+using testing::read_text;
+using testing::ScratchDir;
+using testing::write_text;
 
 int count_files(const fs::path& folder) {
   int count = 0;

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
 #include "strata/core/io/tetgen.hpp"
@@ -17,34 +18,9 @@ namespace strata {
 namespace {
 
 namespace fs = std::filesystem;
-
-class ScratchDir {
- public:
-  explicit ScratchDir(const std::string& tag)
-      : m_path(fs::temp_directory_path() / ("strata_" + tag + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(m_path);
-    fs::create_directories(m_path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(m_path, ignored);
-  }
-  fs::path operator/(const std::string& name) const { return m_path / name; }
-
- private:
-  fs::path m_path;
-};
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
-}
+using testing::read_text;
+using testing::ScratchDir;
+using testing::write_text;
 
 /// Reading `path` throws an InputError whose message names the file and contains `detail`.
 void expect_input_error(const fs::path& path, const std::string& detail = "") {

@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/gmsh.hpp"
 #include "strata/core/io/mesh_io.hpp"
@@ -18,25 +19,11 @@ namespace strata {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::read_text;
+using testing::ScratchDir;
+using testing::write_text;
 
 /// A fresh folder under the system temp folder, removed at the end of the test.
-class ScratchDir {
- public:
-  explicit ScratchDir(const std::string& tag)
-      : m_path(fs::temp_directory_path() / ("strata_" + tag + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(m_path);
-    fs::create_directories(m_path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(m_path, ignored);
-  }
-  fs::path operator/(const std::string& name) const { return m_path / name; }
-
- private:
-  fs::path m_path;
-};
-
 /// A box mesh with irregular coordinates, so the round trip exercises all 17 digits.
 TetMesh irregular_box() {
   TetMesh mesh =

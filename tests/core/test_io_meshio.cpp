@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+#include "io_test_utils.hpp"
 #include "strata/core/io/mesh_io.hpp"
 #include "strata/core/io/vtu.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -14,23 +15,9 @@ namespace strata {
 namespace {
 
 namespace fs = std::filesystem;
-
-class ScratchDir {
- public:
-  explicit ScratchDir(const std::string& tag)
-      : m_path(fs::temp_directory_path() / ("strata_" + tag + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(m_path);
-    fs::create_directories(m_path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(m_path, ignored);
-  }
-  fs::path operator/(const std::string& name) const { return m_path / name; }
-
- private:
-  fs::path m_path;
-};
+using testing::read_text;
+using testing::ScratchDir;
+using testing::write_text;
 
 const char* const kPython = "/usr/bin/python3";
 

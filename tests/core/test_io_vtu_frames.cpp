@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/pvd.hpp"
 #include "strata/core/io/vtu.hpp"
@@ -16,30 +17,9 @@ namespace strata {
 namespace {
 
 namespace fs = std::filesystem;
-
-class ScratchDir {
- public:
-  explicit ScratchDir(const std::string& tag)
-      : m_path(fs::temp_directory_path() / ("strata_" + tag + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(m_path);
-    fs::create_directories(m_path);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(m_path, ignored);
-  }
-  fs::path operator/(const std::string& name) const { return m_path / name; }
-
- private:
-  fs::path m_path;
-};
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
-}
+using testing::read_text;
+using testing::ScratchDir;
+using testing::write_text;
 
 int count(const std::string& text, const std::string& what) {
   int n = 0;
