@@ -288,25 +288,34 @@ namespace {
 
 /// StVK element stiffness in closed form, block (b, a) = ∂²W/∂x_b∂x_a:
 /// V [(g_aᵀ S g_b) I + λ (F g_b)(F g_a)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_a)(F g_b)ᵀ], g_k = ∇N_k.
+/// Plain scalar arrays on purpose: mixing Eigen's packed 3 × 3 temporaries with scalar diagonal
+/// updates caused store-forwarding stalls that took half of the assembly time.
 void stvk_stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double, 4, 3>& grad_N,
                            const LameParameters& lame, double volume, Matrix3d (&blocks)[4][4]) {
   const Matrix3d S = second_piola_stvk(F, lame);
-  const Matrix3d FFt = F * F.transpose();
-  Eigen::Matrix<double, 3, 4> Fg;  // columns F g_k
-  Eigen::Matrix<double, 3, 4> Sg;  // columns S g_k
-  for (int k = 0; k < 4; ++k) {
-    Fg.col(k) = F * grad_N.row(k).transpose();
-    Sg.col(k) = S * grad_N.row(k).transpose();
-  }
+  double Fg[4][3], Sg[4][3], FFt[3][3];
+  for (int k = 0; k < 4; ++k)
+    for (int r = 0; r < 3; ++r) {
+      Fg[k][r] = F(r, 0) * grad_N(k, 0) + F(r, 1) * grad_N(k, 1) + F(r, 2) * grad_N(k, 2);
+      Sg[k][r] = S(r, 0) * grad_N(k, 0) + S(r, 1) * grad_N(k, 1) + S(r, 2) * grad_N(k, 2);
+    }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      FFt[r][c] = F(r, 0) * F(c, 0) + F(r, 1) * F(c, 1) + F(r, 2) * F(c, 2);
+  const double lambda = volume * lame.lambda, mu = volume * lame.mu;
   for (int b = 0; b < 4; ++b)
     for (int a = b; a < 4; ++a) {
-      const double geometric = grad_N.row(a).dot(Sg.col(b));
-      const double gg = grad_N.row(a).dot(grad_N.row(b));
-      Matrix3d block = lame.lambda * Fg.col(b) * Fg.col(a).transpose() +
-                       lame.mu * Fg.col(a) * Fg.col(b).transpose() + lame.mu * gg * FFt;
-      block.diagonal().array() += geometric;
-      blocks[b][a] = volume * block;
-      if (a != b) blocks[a][b] = blocks[b][a].transpose();
+      const double geometric =
+          volume * (grad_N(a, 0) * Sg[b][0] + grad_N(a, 1) * Sg[b][1] + grad_N(a, 2) * Sg[b][2]);
+      const double gg = mu * (grad_N(a, 0) * grad_N(b, 0) + grad_N(a, 1) * grad_N(b, 1) +
+                              grad_N(a, 2) * grad_N(b, 2));
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          const double value = lambda * Fg[b][r] * Fg[a][c] + mu * Fg[a][r] * Fg[b][c] +
+                               gg * FFt[r][c] + (r == c ? geometric : 0.0);
+          blocks[b][a](r, c) = value;
+          blocks[a][b](c, r) = value;
+        }
     }
 }
 
