@@ -320,21 +320,27 @@ void stvk_stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double, 4, 3>&
 }
 
 /// Element stiffness blocks from the generic ∂²ψ/∂F²:
-/// K_ab = V Σ_{c,d} ∇N_a[c] ∇N_b[d] · (∂²ψ/∂F_{·c}∂F_{·d}).
+/// K_ab = V Σ_{c,d} ∇N_a[c] ∇N_b[d] · (∂²ψ/∂F_{·c}∂F_{·d}). Plain arrays, as for StVK.
 void generic_stiffness_blocks(const Matrix9d& d2psi, const Eigen::Matrix<double, 4, 3>& grad_N,
                               double volume, Matrix3d (&blocks)[4][4]) {
-  Eigen::Matrix<double, 9, 12> right;  // column (b, r): Σ_d d2psi(:, 3d + r) ∇N_b[d]
+  double g[4][3];
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < 3; ++d)
+      g[k][d] = grad_N(k, d);
+  const double* H = d2psi.data();  // H[i + 9 j] = d2psi(i, j)
+  double right[12][9];             // right[3b + r][i] = Σ_d d2psi(i, 3d + r) ∇N_b[d]
   for (int b = 0; b < 4; ++b)
     for (int r = 0; r < 3; ++r)
-      right.col(3 * b + r) = grad_N(b, 0) * d2psi.col(r) + grad_N(b, 1) * d2psi.col(3 + r) +
-                             grad_N(b, 2) * d2psi.col(6 + r);
-  for (int a = 0; a < 4; ++a) {
-    const Eigen::Matrix<double, 3, 12> rows =
-        volume * (grad_N(a, 0) * right.middleRows<3>(0) + grad_N(a, 1) * right.middleRows<3>(3) +
-                  grad_N(a, 2) * right.middleRows<3>(6));
+      for (int i = 0; i < 9; ++i)
+        right[3 * b + r][i] =
+            H[i + 9 * r] * g[b][0] + H[i + 9 * (3 + r)] * g[b][1] + H[i + 9 * (6 + r)] * g[b][2];
+  for (int a = 0; a < 4; ++a)
     for (int b = 0; b < 4; ++b)
-      blocks[a][b] = rows.middleCols<3>(3 * b);
-  }
+      for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q)
+          blocks[a][b](q, r) =
+              volume * (g[a][0] * right[3 * b + r][q] + g[a][1] * right[3 * b + r][3 + q] +
+                        g[a][2] * right[3 * b + r][6 + q]);
 }
 
 }  // namespace
