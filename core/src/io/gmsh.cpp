@@ -175,14 +175,8 @@ TetMesh assemble(const GmshContent& content, const std::string& source) {
 
 void write_v2(std::ostream& out, const TetMesh& mesh) {
   out << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << mesh.vertices.rows() << '\n';
-  for (Index v = 0; v < mesh.vertices.rows(); ++v) {
-    out << v + 1;
-    for (int d = 0; d < 3; ++d) {
-      out << ' ';
-      write_double(out, mesh.vertices(v, d));
-    }
-    out << '\n';
-  }
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    write_numbered_point(out, v + 1, mesh.vertices.row(v));
   out << "$EndNodes\n$Elements\n" << mesh.tets.rows() << '\n';
   // Two tags per element: physical group 1, elementary volume 1.
   for (Index t = 0; t < mesh.tets.rows(); ++t)

@@ -67,14 +67,8 @@ TetMesh read_tetgen(const std::filesystem::path& path) {
 void write_tetgen(const std::filesystem::path& path, const TetMesh& mesh) {
   write_file_atomically(with_extension(path, ".node"), [&](std::ostream& out) {
     out << mesh.vertices.rows() << " 3 0 0\n";
-    for (Index v = 0; v < mesh.vertices.rows(); ++v) {
-      out << v + 1;
-      for (int d = 0; d < 3; ++d) {
-        out << ' ';
-        write_double(out, mesh.vertices(v, d));
-      }
-      out << '\n';
-    }
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      write_numbered_point(out, v + 1, mesh.vertices.row(v));
   });
   write_file_atomically(with_extension(path, ".ele"), [&](std::ostream& out) {
     out << mesh.tets.rows() << " 4 0\n";

@@ -23,6 +23,8 @@ std::string quoted(std::string_view token) {
   return "'" + shown + "'";
 }
 
+}  // namespace
+
 std::string read_file(const std::filesystem::path& path) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error))
@@ -34,8 +36,6 @@ std::string read_file(const std::filesystem::path& path) {
   if (in.bad()) throw InputError("cannot read '" + path.string() + "'");
   return std::move(content).str();
 }
-
-}  // namespace
 
 bool parse_double(std::string_view token, double& value) {
   if (!token.empty() && token.front() == '+') token.remove_prefix(1);

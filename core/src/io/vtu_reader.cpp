@@ -2,10 +2,8 @@
 #include <cctype>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -272,17 +270,6 @@ std::vector<double> read_data_array(const VtuParser& parser, const XmlTag& tag,
   return values;
 }
 
-std::string read_text(const std::filesystem::path& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error))
-    throw InputError("cannot open '" + path.string() + "': it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot open '" + path.string() + "'");
-  std::ostringstream content;
-  content << in.rdbuf();
-  return std::move(content).str();
-}
-
 long long parse_count(const VtuParser& parser, const XmlTag& tag, std::string_view key) {
   long long value = -1;
   const std::optional<std::string_view> text = tag.attribute(key);
@@ -300,7 +287,7 @@ bool is_index(double value, double limit) {
 
 TetMesh read_vtu(const std::filesystem::path& path) {
   const std::string source = path.string();
-  VtuParser parser(read_text(path), source);
+  VtuParser parser(read_file(path), source);
   enum class Section { none, points, cells, other };
   Section section = Section::none;
   FileSettings settings;

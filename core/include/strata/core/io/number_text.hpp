@@ -14,4 +14,16 @@ inline void write_double(std::ostream& out, double value) {
   out.write(buffer, result.ptr - buffer);
 }
 
+/// Writes one line "index x y z" (coordinates in round-trip form), as gmsh 2.2 and TetGen list
+/// their nodes.
+template <typename Row>
+void write_numbered_point(std::ostream& out, long long index, const Row& point) {
+  out << index;
+  for (int d = 0; d < 3; ++d) {
+    out << ' ';
+    write_double(out, point(d));
+  }
+  out << '\n';
+}
+
 }  // namespace strata

@@ -10,6 +10,10 @@
 
 namespace strata {
 
+/// The whole content of a file; InputError naming the path if it is missing, a directory or
+/// unreadable.
+std::string read_file(const std::filesystem::path& path);
+
 class TextTokenizer {
  public:
   /// Reads the whole file. `comment` starts a comment running to the end of the line ('\0': none).
