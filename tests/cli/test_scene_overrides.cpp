@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "cli_test_utils.hpp"
 #include "strata/app/scene_overrides.hpp"
 #include "strata/app/scene_parser.hpp"
 
@@ -67,7 +68,7 @@ TEST(SceneOverrides, BadPathsNameThePath) {
 class SceneOverridesOnFile : public ::testing::Test {
  protected:
   void SetUp() override {
-    m_file = std::filesystem::temp_directory_path() / "strata_cli_override_scene.json";
+    m_file = m_folder.path() / "scene.json";
     std::ofstream out(m_file);
     out << R"({
       "mesh": {"box": {"min": [0, 0, 0], "max": [1, 0.1, 0.1], "cells": [4, 1, 1]}},
@@ -76,7 +77,7 @@ class SceneOverridesOnFile : public ::testing::Test {
       "solver": {"mode": "static"}
     })";
   }
-  void TearDown() override { std::filesystem::remove(m_file); }
+  cli_test::TempFolder m_folder;  // per test and process: ctest runs tests in parallel
   std::filesystem::path m_file;
 };
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "cli_test_utils.hpp"
 #include "strata/app/scene_parser.hpp"
 
 namespace strata::app {
@@ -211,8 +212,8 @@ TEST(SceneParser, ExclusiveAlternatives) {
 }
 
 TEST(SceneParser, MalformedJsonReportsLineAndColumn) {
-  const std::filesystem::path file =
-      std::filesystem::temp_directory_path() / "strata_cli_malformed_scene.json";
+  const cli_test::TempFolder folder;
+  const std::filesystem::path file = folder.path() / "malformed_scene.json";
   {
     std::ofstream out(file);
     out << "{\n  \"mesh\": {\"box\": 1},\n  \"material\": {,}\n}\n";
@@ -223,7 +224,6 @@ TEST(SceneParser, MalformedJsonReportsLineAndColumn) {
   } catch (const InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr(file.string() + ": line 3, column 16:"));
   }
-  std::filesystem::remove(file);
   EXPECT_THROW(read_json_file(file), InputError);
 }
 
