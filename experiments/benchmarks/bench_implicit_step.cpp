@@ -43,7 +43,8 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
   const auto [lo, hi] = bounding_box(c.mesh.vertices);
 
   const SolverSettings settings;
-  const DynamicsSystem system{model,
+  const EmbeddedElasticModel embedded(model);
+  const DynamicsSystem system{embedded,
                               dof_mass,
                               f_ext,
                               mat.mass_damping,

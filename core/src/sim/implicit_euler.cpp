@@ -12,7 +12,7 @@ ImplicitEuler::ImplicitEuler(const DynamicsSystem& system, LinearSolverKind solv
 
 NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
   const DynamicsSystem& sys = m_system;
-  const ElasticModel& model = sys.model;
+  const EmbeddedElasticModel& model = sys.model;
   const VectorXd& M = sys.dof_mass;
   const double alpha = sys.mass_damping;
   const double beta = sys.stiffness_damping;
@@ -63,7 +63,7 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
   settings.step_tolerance = 1e-13 * sys.diagonal;
   settings.residual_floor = internal_force_roundoff(model);
   const LameParameters lame = model.material().lame();
-  settings.energy_scale = (2 * lame.mu + lame.lambda) * model.rest_data().rest_volume.sum() +
+  settings.energy_scale = (2 * lame.mu + lame.lambda) * model.total_rest_volume() +
                           std::abs(sys.external_forces.dot(y)) +
                           0.5 / (h * h) * (y - x_tilde).dot(M.cwiseProduct(y - x_tilde));
 

@@ -28,9 +28,9 @@ bool solve_with_shift(SpdSolver& solver, SparseMatrixd& H, const VectorXd& rhs, 
 
 }  // namespace
 
-double internal_force_roundoff(const ElasticModel& model) {
+double internal_force_roundoff(const EmbeddedElasticModel& model) {
   const LameParameters lame = model.material().lame();
-  const double h = mean_edge_length(unflatten(model.rest_positions()), model.tets());
+  const double h = model.mean_edge_length();
   return 1e3 * std::numeric_limits<double>::epsilon() * (2 * lame.mu + lame.lambda) * h * h *
          std::sqrt(static_cast<double>(model.num_dofs()));
 }

@@ -32,12 +32,13 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                        const std::vector<DirichletSpec>& dirichlet,
                        const std::vector<RegionLoad>& loads,
                        const std::optional<GroundPlane>& ground, const Vector3d& gravity,
-                       const SolverSettings& settings)
+                       const SolverSettings& settings, SimulationOptions options)
     : m_mesh(std::move(mesh)), m_material(material), m_settings(settings), m_ground(ground) {
   validate_material(m_material, "material");
   validate_solver_settings(m_settings, "solver");
   if (m_ground) validate_ground(*m_ground, "ground");
   if (!gravity.allFinite()) throw InputError("gravity: must be finite");
+  if (options.first_step < 0) throw InputError("simulation: first_step must be >= 0");
   std::vector<char> referenced(m_mesh.vertices.rows(), 0);
   for (Index t = 0; t < m_mesh.tets.rows(); ++t)
     for (int k = 0; k < 4; ++k)
@@ -50,47 +51,73 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
         "dirichlet: static mode needs at least one Dirichlet group against rigid motion");
 
   m_model = std::make_unique<ElasticModel>(m_mesh.vertices, m_mesh.tets, m_material);
+  if (options.dof_vertices.empty())
+    m_embedded = std::make_unique<EmbeddedElasticModel>(*m_model);
+  else
+    m_embedded = std::make_unique<EmbeddedElasticModel>(
+        *m_model, std::move(options.vertex_embedding), std::move(options.dof_vertices));
   const Index num_vertices = m_mesh.vertices.rows();
+  const Index num_dof_vertices = m_embedded->num_dof_vertices();
   m_boundary = boundary_faces(m_mesh.tets);
   m_vertex_mass = lumped_vertex_mass(m_model->rest_data().rest_volume, m_mesh.tets, num_vertices,
                                      m_material.density);
-  m_dof_mass.resize(3 * num_vertices);
-  for (Index v = 0; v < num_vertices; ++v)
-    m_dof_mass.segment<3>(3 * v).setConstant(m_vertex_mass[v]);
+  m_dof_vertex_mass = m_embedded->reduce_vertex_scalar(m_vertex_mass);
+  m_dof_mass.resize(3 * num_dof_vertices);
+  for (Index v = 0; v < num_dof_vertices; ++v)
+    m_dof_mass.segment<3>(3 * v).setConstant(m_dof_vertex_mass[v]);
 
   const auto [lo, hi] = bounding_box(m_mesh.vertices);
   m_diagonal = (hi - lo).norm();
   const double tolerance = region_tolerance(m_mesh.vertices);
-  m_groups = resolve_dirichlet_groups(dirichlet, m_mesh.vertices, tolerance);
-  m_constrained = dirichlet_dof_mask(m_groups, num_vertices);
-  m_external = strata::external_forces(m_mesh.vertices, m_boundary, m_vertex_mass, gravity, loads,
-                                       tolerance);
+  const MatrixX3d dof_rest = unflatten(m_embedded->rest_positions());
+  m_groups = resolve_dirichlet_groups(dirichlet, dof_rest, tolerance);
+  m_constrained = dirichlet_dof_mask(m_groups, num_dof_vertices);
+  VectorXd mesh_external = strata::external_forces(m_mesh.vertices, m_boundary, m_vertex_mass,
+                                                   gravity, loads, tolerance);
+  if (options.extra_mesh_forces.size() > 0) {
+    if (options.extra_mesh_forces.size() != mesh_external.size() ||
+        !options.extra_mesh_forces.allFinite())
+      throw InputError("simulation: extra_mesh_forces must be 3·#V finite values");
+    mesh_external += options.extra_mesh_forces;
+  }
+  m_external = m_embedded->reduce(mesh_external);
   m_stable_dt =
       stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
   m_limits = default_divergence_limits(m_material, m_diagonal);
   if (m_ground)
-    m_ground_stiffness = ground_penalty_stiffness(m_material.youngs_modulus,
-                                                  mean_edge_length(m_mesh.vertices, m_mesh.tets),
-                                                  m_settings.contact_stiffness_factor);
+    m_ground_stiffness =
+        ground_penalty_stiffness(m_material.youngs_modulus, m_embedded->mean_edge_length(),
+                                 m_settings.contact_stiffness_factor);
 
-  m_x = m_model->rest_positions();
+  m_first_step = options.first_step;
+  m_steps = m_first_step;
+  m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
   m_x_previous = m_x;
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
-  m_system.reset(new DynamicsSystem{*m_model, m_dof_mass, m_external, m_material.mass_damping,
+  m_system.reset(new DynamicsSystem{*m_embedded, m_dof_mass, m_external, m_material.mass_damping,
                                     m_material.stiffness_damping, m_groups, m_constrained,
                                     ramp_time, m_diagonal});
   if (is_static(m_settings)) {
     m_static = std::make_unique<StaticSolver>(
-        *m_model, m_external, m_groups, m_constrained, m_ground, m_ground_stiffness,
+        *m_embedded, m_external, m_groups, m_constrained, m_ground, m_ground_stiffness,
         m_settings.linear_solver, m_settings.max_newton_iterations, m_settings.newton_tolerance);
+    if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), 0.0, m_x, m_v);
+    m_v.setZero();
   } else {
     if (m_settings.integrator == Integrator::implicit_euler)
       m_implicit = std::make_unique<ImplicitEuler>(*m_system, m_settings.linear_solver,
                                                    m_settings.max_newton_iterations,
                                                    m_settings.newton_tolerance);
-    m_system->apply_constraints(0.0, m_x, m_v);
+    m_system->apply_constraints(time(), m_x, m_v);
   }
+  update_mesh_state();
+}
+
+void Simulation::update_mesh_state() {
+  if (m_embedded->is_identity()) return;
+  m_mesh_x = m_embedded->expand(m_x);
+  m_mesh_v = m_embedded->expand(m_v);
 }
 
 Simulation::~Simulation() = default;
@@ -104,11 +131,12 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
   m_x = positions;
   m_v = is_static(m_settings) ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
   if (is_static(m_settings)) {
-    apply_dirichlet(m_groups, m_model->rest_positions(), load_factor(), 0.0, m_x, m_v);
+    apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), 0.0, m_x, m_v);
     m_x_previous = m_x;
   } else {
     m_system->apply_constraints(time(), m_x, m_v);
   }
+  update_mesh_state();
 }
 
 double Simulation::time() const {
@@ -167,25 +195,29 @@ void Simulation::advance_dynamic() {
   }
   if (m_ground) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
   ++m_steps;
-  check_divergence(*m_model, m_x, m_v, m_limits, m_steps, time(), to_string(m_settings.integrator));
+  update_mesh_state();
+  check_divergence(*m_model, positions(), velocities(), m_limits, m_steps, time(),
+                   to_string(m_settings.integrator));
 }
 
 void Simulation::advance_static() {
   const double lambda = static_cast<double>(m_steps + 1) / m_settings.load_steps;
   VectorXd guess = m_x;
-  if (m_steps >= 1) guess += m_x - m_x_previous;  // linear extrapolation along the load path
+  if (m_steps > m_first_step)
+    guess += m_x - m_x_previous;  // linear extrapolation along the load path
   const NewtonResult result = m_static->solve(lambda, guess);
   m_newton_iterations += result.iterations;
   if (!result.converged) throw_newton_failure("static", result.iterations, result.residual);
   m_x_previous = m_x;
   m_x = guess;
   ++m_steps;
-  check_divergence(*m_model, m_x, VectorXd(), m_limits, m_steps, lambda, "static");
+  update_mesh_state();
+  check_divergence(*m_model, positions(), VectorXd(), m_limits, m_steps, lambda, "static");
 }
 
 std::vector<GroupReaction> Simulation::reactions() const {
   VectorXd f_int;
-  m_model->forces(m_x, f_int);
+  m_embedded->forces(m_x, f_int);
   VectorXd f = f_int;
   VectorXd mass_times_acceleration = VectorXd::Zero(m_x.size());
   if (is_static(m_settings)) {
@@ -218,17 +250,17 @@ double Simulation::kinetic_energy() const {
 }
 
 double Simulation::elastic_energy() const {
-  return m_model->energy(m_x);
+  return m_embedded->energy(m_x);
 }
 
 double Simulation::external_potential_energy() const {
   const double scale = is_static(m_settings) ? load_factor() : 1.0;
-  return -scale * m_external.dot(m_x - m_model->rest_positions());
+  return -scale * m_external.dot(m_x - m_embedded->rest_positions());
 }
 
 SimulationCounters Simulation::counters() const {
   SimulationCounters counters;
-  counters.steps = m_steps;
+  counters.steps = m_steps - m_first_step;
   counters.newton_iterations = m_newton_iterations;
   counters.element_evaluations = m_model->element_evaluations();
   if (m_implicit) counters.factorizations = m_implicit->linear_solver().factorizations();

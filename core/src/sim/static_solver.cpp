@@ -4,7 +4,7 @@
 
 namespace strata {
 
-StaticSolver::StaticSolver(const ElasticModel& model, const VectorXd& external_forces,
+StaticSolver::StaticSolver(const EmbeddedElasticModel& model, const VectorXd& external_forces,
                            const std::vector<DirichletGroup>& groups,
                            const std::vector<char>& constrained,
                            const std::optional<GroundPlane>& ground, double ground_stiffness,
@@ -61,7 +61,7 @@ NewtonResult StaticSolver::solve(double load_factor, VectorXd& x) {
       (unflatten(rest).colwise().maxCoeff() - unflatten(rest).colwise().minCoeff()).norm();
   settings.step_tolerance = 1e-14 * size;
   const LameParameters lame = m_model.material().lame();
-  settings.energy_scale = (2 * lame.mu + lame.lambda) * m_model.rest_data().rest_volume.sum() +
+  settings.energy_scale = (2 * lame.mu + lame.lambda) * m_model.total_rest_volume() +
                           std::abs(lambda * m_external_forces.dot(x));
   return newton_minimize({energy, gradient, hessian}, m_reduction, m_solver, settings, x);
 }

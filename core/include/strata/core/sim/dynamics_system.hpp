@@ -2,7 +2,8 @@
 /// \file dynamics_system.hpp
 /// The equations of motion shared by the integrators:
 ///   M a = f_int(x) + f_ext + f_damp(x, v),   f_damp = −(α M + β K(x)) v  (Rayleigh),
-/// with lumped (diagonal) M, dead loads f_ext and Dirichlet groups ramped by s(t) = min(t/T_r, 1).
+/// on the DOFs q of an EmbeddedElasticModel (q = x for a plain mesh), with lumped (diagonal) M,
+/// dead loads f_ext and Dirichlet groups ramped by s(t) = min(t/T_r, 1).
 ///
 /// Explicit integrators evaluate K(x) v matrix-free by a one-sided finite difference of the
 /// elastic forces, K v ≈ −(f_int(x + εv) − f_int(x)) / ε with ε‖v‖∞ = 10⁻⁷ × the bounding-box
@@ -10,19 +11,19 @@
 #include <vector>
 
 #include "strata/core/common/types.hpp"
-#include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/sim/dirichlet.hpp"
+#include "strata/core/sim/embedded_model.hpp"
 
 namespace strata {
 
 struct DynamicsSystem {
-  const ElasticModel& model;
-  const VectorXd& dof_mass;         ///< lumped mass per DOF, 3·#V [kg]
-  const VectorXd& external_forces;  ///< f_ext, 3·#V [N]
-  double mass_damping;              ///< α [1/s]
-  double stiffness_damping;         ///< β [s]
+  const EmbeddedElasticModel& model;  ///< elastic forces on the DOFs q (x = P q)
+  const VectorXd& dof_mass;           ///< lumped mass per DOF, 3·#Q [kg]
+  const VectorXd& external_forces;    ///< f_ext, 3·#Q [N]
+  double mass_damping;                ///< α [1/s]
+  double stiffness_damping;           ///< β [s]
   const std::vector<DirichletGroup>& groups;
-  const std::vector<char>& constrained;  ///< 3·#V flags
+  const std::vector<char>& constrained;  ///< 3·#Q flags
   double ramp_time;                      ///< T_r [s] > 0
   double diagonal;                       ///< bounding-box diagonal [m] (FD step scale)
 

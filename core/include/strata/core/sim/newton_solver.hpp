@@ -6,7 +6,7 @@
 #include <functional>
 
 #include "strata/core/common/types.hpp"
-#include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/dof_reduction.hpp"
 #include "strata/core/sim/linear_solver.hpp"
 
@@ -44,7 +44,7 @@ struct NewtonResult {
 /// Round-off level of the elastic forces of `model` near the rest state [N]:
 /// 10³ ε_machine · (2μ + λ) · h̄² · √(3·#V), with h̄ the mean rest edge length — the stress noise
 /// of F ≈ I times a face area, accumulated over the DOFs.
-double internal_force_roundoff(const ElasticModel& model);
+double internal_force_roundoff(const EmbeddedElasticModel& model);
 
 /// Minimises from the initial guess `x` (3·#V, updated in place). Each iteration: gradient,
 /// Hessian, reduce to free DOFs, solve H Δ = −g (on failure, retry with a growing diagonal shift),

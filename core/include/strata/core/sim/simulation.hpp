@@ -8,6 +8,14 @@
 /// estimate) → set_state (optional initial velocity / shape) → while (!finished()) advance() →
 /// query positions, energies, reactions and counters at any point.
 ///
+/// Embedding (optional, SimulationOptions): the mesh's vertices may be a linear function of fewer
+/// DOF vertices, x = (C ⊗ I₃) q (embedded_model.hpp) — the hanging vertices of an active cut of
+/// the refinement tree. The state, masses (m_q = Cᵀ m), loads (f_q = Cᵀ f), Dirichlet groups
+/// (resolved on the DOF vertices' rest positions), contact and reactions then live on q; every
+/// integrator and the static solver run unchanged. `positions()`/`velocities()` always return the
+/// mesh's 3·#V vectors (x = P q), `dof_positions()`/`dof_velocities()` the 3·#Q state. Without an
+/// embedding q = x and both coincide.
+///
 /// Reactions: for each Dirichlet group, the force the constraint exerts on the body,
 ///   R = Σ_{i ∈ group} (m_i a_i − f_int,i − f_ext,i − f_damp,i − f_contact,i),
 /// with a_i the prescribed acceleration (zero in static mode, f_ext scaled by the load factor
@@ -22,6 +30,7 @@
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/divergence_check.hpp"
+#include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/solver_settings.hpp"
@@ -40,7 +49,23 @@ struct GroupReaction {
   Vector3d moment_center = Vector3d::Zero();  ///< [m]
 };
 
-/// Work counters.
+/// Optional construction parameters, for drivers that rebuild the simulation on a new mesh
+/// mid-run (the adaptive hierarchy).
+struct SimulationOptions {
+  /// x = (C ⊗ I₃) q: C (#V × #Q, rows sum to 1, non-negative) and the mesh vertex of each DOF
+  /// vertex (identity rows). Empty `dof_vertices`: no embedding (q = x).
+  SparseMatrixd vertex_embedding;
+  std::vector<int> dof_vertices;
+  /// Dead loads on the mesh vertices (3·#V [N]) added to gravity and the region loads, e.g. loads
+  /// defined on a finer mesh and mapped onto this one; empty for none.
+  VectorXd extra_mesh_forces;
+  /// Step index the run starts from: time() = (first_step + steps taken) · dt in dynamic mode,
+  /// load factor (first_step + steps taken) / load_steps in static mode, and the Dirichlet ramp
+  /// continues from there.
+  long first_step = 0;
+};
+
+/// Work counters of this Simulation object (not including steps before `first_step`).
 struct SimulationCounters {
   long steps = 0;                     ///< time or load steps taken
   long newton_iterations = 0;         ///< over all implicit / static steps
@@ -55,13 +80,15 @@ class Simulation {
   /// an empty Dirichlet group or load region, or static mode without any Dirichlet group.
   Simulation(TetMesh mesh, const Material& material, const std::vector<DirichletSpec>& dirichlet,
              const std::vector<RegionLoad>& loads, const std::optional<GroundPlane>& ground,
-             const Vector3d& gravity, const SolverSettings& settings);
+             const Vector3d& gravity, const SolverSettings& settings,
+             SimulationOptions options = {});
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
-  /// Replaces the state (3·#V each; e.g. an initial velocity); Dirichlet DOFs are reset to their
-  /// targets at the current time. Throws InputError on a size mismatch or non-finite values.
+  /// Replaces the DOF state (3·#Q each, = 3·#V without an embedding; e.g. an initial velocity);
+  /// Dirichlet DOFs are reset to their targets at the current time. Throws InputError on a size
+  /// mismatch or non-finite values.
   void set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velocities);
 
   /// One time step of `dt` (dynamic) or one load step (static). Throws DivergenceError naming the
@@ -72,12 +99,17 @@ class Simulation {
   /// ⌈duration/dt⌉ steps). Static: all load_steps done.
   bool finished() const;
 
-  const VectorXd& positions() const { return m_x; }   ///< 3·#V [m]
-  const VectorXd& velocities() const { return m_v; }  ///< 3·#V [m/s] (zero in static mode)
+  /// Mesh positions x = P q, 3·#V [m].
+  const VectorXd& positions() const { return m_embedded->is_identity() ? m_x : m_mesh_x; }
+  /// Mesh velocities P v_q, 3·#V [m/s] (zero in static mode).
+  const VectorXd& velocities() const { return m_embedded->is_identity() ? m_v : m_mesh_v; }
+  const VectorXd& dof_positions() const { return m_x; }   ///< q, 3·#Q [m]
+  const VectorXd& dof_velocities() const { return m_v; }  ///< 3·#Q [m/s]
   /// Dynamic: simulated time [s]; static: the load factor k/N.
   double time() const;
   /// Dirichlet ramp / load factor s ∈ [0, 1] of the current state.
   double load_factor() const;
+  /// Absolute step index (first_step + steps taken).
   long step_count() const { return m_steps; }
 
   /// Largest stable step of the chosen integrator [s], a guaranteed bound for the problem
@@ -86,7 +118,7 @@ class Simulation {
   double stable_dt_estimate() const { return m_stable_dt; }
 
   std::vector<GroupReaction> reactions() const;
-  double kinetic_energy() const;  ///< ½ vᵀ M v [J]
+  double kinetic_energy() const;  ///< ½ v_qᵀ M_q v_q [J]
   double elastic_energy() const;  ///< Ψ(x) [J]
   /// Potential of the dead loads −s_f f_extᵀ(x − X) [J] (s_f = load factor in static mode, 1 in
   /// dynamic mode).
@@ -94,17 +126,23 @@ class Simulation {
   SimulationCounters counters() const;
 
   const TetMesh& mesh() const { return m_mesh; }
-  const ElasticModel& model() const { return *m_model; }
+  const ElasticModel& model() const { return *m_model; }  ///< on the mesh (3·#V)
+  /// The model on the DOFs (x = P q).
+  const EmbeddedElasticModel& embedded_model() const { return *m_embedded; }
   const SolverSettings& settings() const { return m_settings; }
+  /// Groups with DOF-vertex indices (= mesh vertices without an embedding).
   const std::vector<DirichletGroup>& dirichlet_groups() const { return m_groups; }
   const MatrixX3i& boundary() const { return m_boundary; }       ///< boundary triangles #F × 3
-  const VectorXd& vertex_mass() const { return m_vertex_mass; }  ///< #V [kg]
-  /// Full (unscaled) external force vector, 3·#V [N].
+  const VectorXd& vertex_mass() const { return m_vertex_mass; }  ///< mesh, #V [kg]
+  /// Lumped masses of the DOF vertices, Cᵀ m (#Q) [kg].
+  const VectorXd& dof_vertex_mass() const { return m_dof_vertex_mass; }
+  /// Full (unscaled) external force vector on the DOFs, 3·#Q [N].
   const VectorXd& external_forces() const { return m_external; }
   const DivergenceLimits& divergence_limits() const { return m_limits; }
 
  private:
   void advance_dynamic();
+  void update_mesh_state();
   void advance_static();
   [[noreturn]] void throw_newton_failure(const std::string& context, int iterations,
                                          double residual) const;
@@ -113,8 +151,10 @@ class Simulation {
   Material m_material;
   SolverSettings m_settings;
   std::unique_ptr<ElasticModel> m_model;
+  std::unique_ptr<EmbeddedElasticModel> m_embedded;
   MatrixX3i m_boundary;
   VectorXd m_vertex_mass;
+  VectorXd m_dof_vertex_mass;
   VectorXd m_dof_mass;
   VectorXd m_external;
   std::vector<DirichletGroup> m_groups;
@@ -131,6 +171,9 @@ class Simulation {
   VectorXd m_x;
   VectorXd m_v;
   VectorXd m_x_previous;  ///< static: equilibrium of the previous load step (extrapolation)
+  VectorXd m_mesh_x;      ///< P q (only with an embedding)
+  VectorXd m_mesh_v;
+  long m_first_step = 0;
   long m_steps = 0;
   long m_newton_iterations = 0;
 };

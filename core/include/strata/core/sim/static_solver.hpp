@@ -8,7 +8,7 @@
 /// the internal forces of the initial guess x₀.
 #include <optional>
 
-#include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/dof_reduction.hpp"
 #include "strata/core/sim/ground_contact.hpp"
@@ -21,7 +21,7 @@ class StaticSolver {
  public:
   /// All references must outlive this object. `ground_stiffness` [N/m] is used when `ground`
   /// is set.
-  StaticSolver(const ElasticModel& model, const VectorXd& external_forces,
+  StaticSolver(const EmbeddedElasticModel& model, const VectorXd& external_forces,
                const std::vector<DirichletGroup>& groups, const std::vector<char>& constrained,
                const std::optional<GroundPlane>& ground, double ground_stiffness,
                LinearSolverKind solver, int max_newton_iterations, double newton_tolerance);
@@ -38,7 +38,7 @@ class StaticSolver {
   const SpdSolver& linear_solver() const { return m_solver; }
 
  private:
-  const ElasticModel& m_model;
+  const EmbeddedElasticModel& m_model;
   const VectorXd& m_external_forces;
   const std::vector<DirichletGroup>& m_groups;
   const std::optional<GroundPlane>& m_ground;

@@ -1,0 +1,185 @@
+#include "strata/core/sim/embedded_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
+
+namespace strata {
+
+namespace {
+
+double rest_edge_length_mean(const ElasticModel& model) {
+  return mean_edge_length(unflatten(model.rest_positions()), model.tets());
+}
+
+}  // namespace
+
+EmbeddedElasticModel::EmbeddedElasticModel(const ElasticModel& model)
+    : m_model(&model),
+      m_identity(true),
+      m_num_dof_vertices(model.num_vertices()),
+      m_rest_positions(model.rest_positions()),
+      m_total_rest_volume(model.rest_data().rest_volume.sum()),
+      m_mean_edge_length(rest_edge_length_mean(model)) {
+  m_dof_vertices.resize(m_num_dof_vertices);
+  for (Index v = 0; v < m_num_dof_vertices; ++v)
+    m_dof_vertices[v] = static_cast<int>(v);
+}
+
+EmbeddedElasticModel::EmbeddedElasticModel(const ElasticModel& model,
+                                           SparseMatrixd vertex_embedding,
+                                           std::vector<int> dof_vertices)
+    : m_model(&model),
+      m_identity(false),
+      m_num_dof_vertices(static_cast<Index>(dof_vertices.size())),
+      m_dof_vertices(std::move(dof_vertices)),
+      m_total_rest_volume(model.rest_data().rest_volume.sum()),
+      m_mean_edge_length(rest_edge_length_mean(model)),
+      m_C(std::move(vertex_embedding)) {
+  const Index num_vertices = model.num_vertices();
+  if (m_C.rows() != num_vertices || m_C.cols() != m_num_dof_vertices)
+    throw InputError("embedding: expected a " + std::to_string(num_vertices) + " x " +
+                     std::to_string(m_num_dof_vertices) + " matrix, got " +
+                     std::to_string(m_C.rows()) + " x " + std::to_string(m_C.cols()));
+  m_C.makeCompressed();
+  m_CT = m_C.transpose();
+  VectorXd row_sums = VectorXd::Zero(num_vertices);
+  for (Index q = 0; q < m_C.outerSize(); ++q)
+    for (SparseMatrixd::InnerIterator it(m_C, q); it; ++it) {
+      if (!(it.value() >= 0.0))
+        throw InputError("embedding: negative weight in row " + std::to_string(it.row()));
+      row_sums[it.row()] += it.value();
+    }
+  for (Index v = 0; v < num_vertices; ++v)
+    if (std::abs(row_sums[v] - 1.0) > 1e-12)
+      throw InputError("embedding: row " + std::to_string(v) + " sums to " +
+                       std::to_string(row_sums[v]) + ", not 1");
+  for (Index q = 0; q < m_num_dof_vertices; ++q) {
+    const int v = m_dof_vertices[q];
+    if (v < 0 || v >= num_vertices || m_C.coeff(v, q) != 1.0)
+      throw InputError("embedding: DOF vertex " + std::to_string(q) +
+                       " has no identity row (mesh vertex " + std::to_string(v) + ")");
+  }
+  m_rest_positions.resize(3 * m_num_dof_vertices);
+  for (Index q = 0; q < m_num_dof_vertices; ++q)
+    m_rest_positions.segment<3>(3 * q) = model.rest_positions().segment<3>(3 * m_dof_vertices[q]);
+  build_reduced_pattern();
+}
+
+VectorXd EmbeddedElasticModel::expand(ConstRef<VectorXd> q) const {
+  if (m_identity) return q;
+  VectorXd x(3 * m_C.rows());
+  const Eigen::Map<const Eigen::MatrixXd> qm(q.data(), 3, m_num_dof_vertices);
+  Eigen::Map<Eigen::MatrixXd> xm(x.data(), 3, m_C.rows());
+  xm.noalias() = qm * m_CT;  // (3 × #Q)(#Q × #V): x_v = Σ_q C_vq q_q
+  return x;
+}
+
+VectorXd EmbeddedElasticModel::reduce(ConstRef<VectorXd> f) const {
+  if (m_identity) return f;
+  VectorXd r(3 * m_num_dof_vertices);
+  const Eigen::Map<const Eigen::MatrixXd> fm(f.data(), 3, m_C.rows());
+  Eigen::Map<Eigen::MatrixXd> rm(r.data(), 3, m_num_dof_vertices);
+  rm.noalias() = fm * m_C;  // r_q = Σ_v C_vq f_v
+  return r;
+}
+
+VectorXd EmbeddedElasticModel::reduce_vertex_scalar(ConstRef<VectorXd> s) const {
+  if (m_identity) return s;
+  return m_CT * s;
+}
+
+double EmbeddedElasticModel::energy(ConstRef<VectorXd> q) const {
+  if (m_identity) return m_model->energy(q);
+  return m_model->energy(expand(q));
+}
+
+void EmbeddedElasticModel::forces(ConstRef<VectorXd> q, VectorXd& f) const {
+  if (m_identity) {
+    m_model->forces(q, f);
+    return;
+  }
+  VectorXd f_mesh;
+  m_model->forces(expand(q), f_mesh);
+  f = reduce(f_mesh);
+}
+
+const SparseMatrixd& EmbeddedElasticModel::stiffness_pattern() const {
+  return m_identity ? m_model->stiffness_pattern() : m_pattern;
+}
+
+void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
+                                     bool project_psd) const {
+  if (m_identity) {
+    m_model->stiffness(q, K, project_psd);
+    return;
+  }
+  m_model->stiffness(expand(q), m_mesh_stiffness, project_psd);
+  if (K.nonZeros() != m_pattern.nonZeros() || K.rows() != m_pattern.rows()) K = m_pattern;
+  double* values = K.valuePtr();
+  std::fill(values, values + K.nonZeros(), 0.0);
+  const double* source = m_mesh_stiffness.valuePtr();
+  for (const Term& term : m_terms)
+    for (int i = 0; i < 3; ++i)
+      values[term.target + i] += term.weight * source[term.source + i];
+}
+
+void EmbeddedElasticModel::build_reduced_pattern() {
+  // The mesh stiffness is 3×3-block dense: column 3w+j holds rows 3v..3v+2 contiguously for every
+  // neighbour v of w. A block (v, w) feeds the reduced blocks (a, b) for C_va ≠ 0, C_wb ≠ 0 with
+  // weight C_va C_wb, column by column (3 contiguous values each).
+  const SparseMatrixd& mesh_pattern = m_model->stiffness_pattern();
+  using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+  const RowMajor C_rows = m_C;
+
+  // Block pattern of the reduced matrix.
+  std::vector<Eigen::Triplet<double>> triplets;
+  const Index num_mesh_vertices = m_C.rows();
+  for (Index w = 0; w < num_mesh_vertices; ++w) {
+    const Index column = 3 * w;
+    for (SparseMatrixd::InnerIterator it(mesh_pattern, column); it; ++it) {
+      if (it.row() % 3 != 0) continue;
+      const Index v = it.row() / 3;
+      for (RowMajor::InnerIterator a(C_rows, v); a; ++a)
+        for (RowMajor::InnerIterator b(C_rows, w); b; ++b)
+          triplets.emplace_back(a.col(), b.col(), 1.0);
+    }
+  }
+  SparseMatrixd blocks(m_num_dof_vertices, m_num_dof_vertices);
+  blocks.setFromTriplets(triplets.begin(), triplets.end());
+  triplets.clear();
+  triplets.reserve(static_cast<size_t>(blocks.nonZeros()) * 9);
+  for (Index b = 0; b < blocks.outerSize(); ++b)
+    for (SparseMatrixd::InnerIterator it(blocks, b); it; ++it)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i)
+          triplets.emplace_back(3 * it.row() + i, 3 * b + j, 0.0);
+  m_pattern.resize(num_dofs(), num_dofs());
+  m_pattern.setFromTriplets(triplets.begin(), triplets.end());
+  m_pattern.makeCompressed();
+
+  // Value offset of the first row of block a in reduced column c.
+  auto reduced_offset = [&](Index a, Index column) {
+    const int* begin = m_pattern.innerIndexPtr() + m_pattern.outerIndexPtr()[column];
+    const int* end = m_pattern.innerIndexPtr() + m_pattern.outerIndexPtr()[column + 1];
+    const int* found = std::lower_bound(begin, end, static_cast<int>(3 * a));
+    return static_cast<Index>(found - m_pattern.innerIndexPtr());
+  };
+  m_terms.clear();
+  for (Index w = 0; w < num_mesh_vertices; ++w)
+    for (int j = 0; j < 3; ++j) {
+      const Index column = 3 * w + j;
+      for (Index k = mesh_pattern.outerIndexPtr()[column];
+           k < mesh_pattern.outerIndexPtr()[column + 1]; k += 3) {
+        const Index v = mesh_pattern.innerIndexPtr()[k] / 3;
+        for (RowMajor::InnerIterator a(C_rows, v); a; ++a)
+          for (RowMajor::InnerIterator b(C_rows, w); b; ++b)
+            m_terms.push_back({reduced_offset(a.col(), 3 * b.col() + j), k, a.value() * b.value()});
+      }
+    }
+}
+
+}  // namespace strata
