@@ -1,0 +1,36 @@
+#pragma once
+/// \file cut_state.hpp
+/// What a refinement criterion sees of the simulation on an active cut: the flattened cut, its
+/// deformed positions, per-tet stresses, the applied loads and masses. The adaptive driver fills
+/// one after a step; the indicators (refinement_indicator.hpp) and the controller
+/// (refinement_controller.hpp) only read it.
+#include "strata/core/common/types.hpp"
+#include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/fem/material.hpp"
+#include "strata/hierarchy/tet_tree.hpp"
+#include "strata/hierarchy/tree_flatten.hpp"
+
+namespace strata {
+
+/// A snapshot of the simulation on the flattened active cut `flat` of `tree` (#V vertices,
+/// #T tets). All references must outlive the snapshot.
+struct CutState {
+  const TetTree& tree;
+  /// The flattened active cut: flat.mesh (rest, #V × 3, #T × 4), flat.tet_nodes (#T).
+  const FlatTreeMesh& flat;
+  /// 3·#V deformed positions of the flat vertices [m] (hanging ones included, x = C q).
+  Eigen::Ref<const VectorXd> positions;
+  /// ElasticModel::tet_fields(positions): per flat tet Green strain, Cauchy stress (Voigt
+  /// [xx yy zz xy yz xz], Pa), von Mises.
+  const TetFields& fields;
+  /// 3·#V dead loads on the flat vertices [N]: gravity plus region loads, loads defined on the
+  /// finest level mapped onto the flat vertices through barycentric weights.
+  Eigen::Ref<const VectorXd> external_forces;
+  /// #V lumped vertex masses [kg].
+  Eigen::Ref<const VectorXd> vertex_mass;
+  const Material& material;
+  /// The driver's step counter (for the controller's hysteresis in steps).
+  long step = 0;
+};
+
+}  // namespace strata

@@ -1,0 +1,36 @@
+#include "strata/hierarchy/refinement_indicator.hpp"
+
+#include <cmath>
+
+namespace strata {
+
+double voigt_frobenius_norm(const Vector6d& voigt) {
+  return std::sqrt(voigt.head<3>().squaredNorm() + 2.0 * voigt.tail<3>().squaredNorm());
+}
+
+VectorXd tet_stress_norms(const Eigen::Matrix<double, Eigen::Dynamic, 6>& cauchy_stress) {
+  VectorXd norms(cauchy_stress.rows());
+  for (Index t = 0; t < cauchy_stress.rows(); ++t)
+    norms[t] = voigt_frobenius_norm(cauchy_stress.row(t).transpose());
+  return norms;
+}
+
+VectorXd tet_rest_volumes(const TetMesh& mesh) {
+  VectorXd volumes(mesh.tets.rows());
+  for (Index t = 0; t < mesh.tets.rows(); ++t)
+    volumes[t] = tet_signed_volume(mesh.vertices.row(mesh.tets(t, 0)).transpose(),
+                                   mesh.vertices.row(mesh.tets(t, 1)).transpose(),
+                                   mesh.vertices.row(mesh.tets(t, 2)).transpose(),
+                                   mesh.vertices.row(mesh.tets(t, 3)).transpose());
+  return volumes;
+}
+
+double volume_rms_stress(const CutState& state) {
+  const VectorXd volumes = tet_rest_volumes(state.flat.mesh);
+  const VectorXd norms = tet_stress_norms(state.fields.cauchy_stress);
+  const double total = volumes.sum();
+  if (!(total > 0.0)) return 0.0;
+  return std::sqrt(volumes.dot(norms.cwiseAbs2()) / total);
+}
+
+}  // namespace strata

@@ -1,0 +1,102 @@
+#pragma once
+// Shared helpers of the refinement-criteria tests: a CutState built from prescribed displacement
+// fields and finest-level point loads on a flattened cut, as the adaptive driver would fill it.
+#include <functional>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/fem/lumped_mass.hpp"
+#include "strata/hierarchy/active_cut.hpp"
+#include "strata/hierarchy/cut_state.hpp"
+#include "strata/hierarchy/hanging_constraints.hpp"
+#include "strata/hierarchy/refinement_indicator.hpp"
+#include "strata/hierarchy/tree_point_location.hpp"
+
+namespace strata::test {
+
+/// Displacement u(X) [m] at a rest point X.
+using DisplacementField = std::function<Vector3d(const Vector3d&)>;
+
+/// A point load defined on the finest level: total force at a rest point (on the body).
+struct PointLoad {
+  Vector3d point;
+  Vector3d force;
+};
+
+/// Everything a CutState refers to, owned.
+struct CutSnapshot {
+  const TetTree* tree = nullptr;
+  ConstrainedCut cut;
+  VectorXd positions;
+  TetFields fields;
+  VectorXd external_forces;
+  VectorXd vertex_mass;
+  Material material;
+  long step = 0;
+
+  CutState state() const {
+    return CutState{*tree,           cut.flat,    positions, fields,
+                    external_forces, vertex_mass, material,  step};
+  }
+};
+
+/// The active node containing rest point p and p's barycentric coordinates in its tet_vertices.
+inline TreeLocation active_location(const ActiveCut& cut, const TreePointLocator& locator,
+                                    const Vector3d& p) {
+  const TetTree& tree = cut.tree();
+  const std::optional<TreeLocation> root = locator.locate_root(p, 1e-9);
+  EXPECT_TRUE(root.has_value());
+  NodeId n = root->node;
+  while (!cut.is_active(n))
+    n = descend_to_point(tree, n, p, tree.level(n) + 1).node;
+  const Matrix3x4d x = tree.tet_positions(n);
+  return {n, tet_barycentric_coordinates(p, x.col(0), x.col(1), x.col(2), x.col(3))};
+}
+
+/// Flattens `cut`, deforms it by u (evaluated at the free vertices, hanging ones follow x = C q),
+/// and maps the point loads onto the vertices of the active tets containing them (barycentric
+/// weights), adding gravity m·g.
+inline CutSnapshot make_snapshot(const ActiveCut& cut, const Material& material,
+                                 const DisplacementField& u, const std::vector<PointLoad>& loads,
+                                 const Vector3d& gravity = Vector3d::Zero(), long step = 0) {
+  CutSnapshot s{&cut.tree(), flatten_cut(cut), {}, {}, {}, {}, material, step};
+  const TetMesh& mesh = s.cut.flat.mesh;
+  const HangingConstraints& hc = s.cut.constraints;
+  VectorXd x = flatten(mesh.vertices);
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    x.segment<3>(3 * v) += u(mesh.vertices.row(v).transpose());
+  s.positions = hc.expand(hc.restrict_to_free(x));
+  const ElasticModel model(mesh.vertices, mesh.tets, material);
+  s.fields = model.tet_fields(s.positions);
+  s.vertex_mass = lumped_vertex_mass(model.rest_data().rest_volume, mesh.tets, mesh.vertices.rows(),
+                                     material.density);
+  s.external_forces = VectorXd::Zero(3 * mesh.vertices.rows());
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    s.external_forces.segment<3>(3 * v) = s.vertex_mass[v] * gravity;
+  if (!loads.empty()) {
+    const TreePointLocator locator(cut.tree());
+    for (const PointLoad& load : loads) {
+      const TreeLocation at = active_location(cut, locator, load.point);
+      const std::array<int, 4> corners = cut.tree().tet_vertices(at.node);
+      for (int i = 0; i < 4; ++i)
+        s.external_forces.segment<3>(3 * s.cut.flat.mesh_vertices[corners[i]]) +=
+            at.barycentric[i] * load.force;
+    }
+  }
+  return s;
+}
+
+/// No displacement.
+inline Vector3d no_motion(const Vector3d&) {
+  return Vector3d::Zero();
+}
+
+/// Rest centroid of a node.
+inline Vector3d node_centroid(const TetTree& tree, NodeId n) {
+  return tree.tet_positions(n).rowwise().mean();
+}
+
+}  // namespace strata::test
