@@ -12,8 +12,8 @@
 #include "strata/core/fem/deformation_gradient.hpp"
 #include "strata/core/fem/green_strain.hpp"
 #include "strata/core/fem/hyperelastic.hpp"
+#include "strata/core/fem/isotropic_hessian.hpp"
 #include "strata/core/fem/isotropic_stress.hpp"
-#include "strata/core/fem/psd_projection.hpp"
 #include "strata/core/fem/stvk.hpp"
 
 namespace strata {
@@ -365,8 +365,8 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
       if (closed_form_stvk) {
         stvk_stiffness_blocks(F, grad_N, m_lame, m_sorted_volume[i], blocks);
       } else {
-        Matrix9d d2psi = d2psi_dF2(m_material.model, F, m_lame);
-        if (project_psd) d2psi = project_to_psd<9>(d2psi);
+        const Matrix9d d2psi = project_psd ? d2psi_dF2_psd(m_material.model, F, m_lame)
+                                           : d2psi_dF2(m_material.model, F, m_lame);
         generic_stiffness_blocks(d2psi, grad_N, m_sorted_volume[i], blocks);
       }
       const int* offsets = &m_block_offsets[48 * i];

@@ -2,7 +2,7 @@
 
 #include "strata/core/fem/deformation_gradient.hpp"
 #include "strata/core/fem/hyperelastic.hpp"
-#include "strata/core/fem/psd_projection.hpp"
+#include "strata/core/fem/isotropic_hessian.hpp"
 
 namespace strata {
 
@@ -24,8 +24,8 @@ Vector12d tet_gradient(MaterialModel model, const LameParameters& lame, const Ve
 
 Matrix12d tet_hessian(MaterialModel model, const LameParameters& lame, const Vector12d& x,
                       const Matrix3d& Dm_inv, double rest_volume, bool project_psd) {
-  Matrix9d d2psi = d2psi_dF2(model, deformation_gradient(tet_positions(x), Dm_inv), lame);
-  if (project_psd) d2psi = project_to_psd<9>(d2psi);
+  const Matrix3d F = deformation_gradient(tet_positions(x), Dm_inv);
+  const Matrix9d d2psi = project_psd ? d2psi_dF2_psd(model, F, lame) : d2psi_dF2(model, F, lame);
   const Eigen::Matrix<double, 9, 12> dF_dx = deformation_gradient_jacobian(Dm_inv);
   return rest_volume * dF_dx.transpose() * d2psi * dF_dx;
 }

@@ -45,7 +45,7 @@ class ElasticModel {
   double energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const;
   /// K = ∂²Ψ/∂x² in the fixed pattern of `stiffness_pattern()`; `K` is set to that pattern on the
   /// first call and only its values are rewritten afterwards. With `project_psd`, each element's
-  /// ∂²ψ/∂F² is projected to PSD first.
+  /// ∂²ψ/∂F² is projected to PSD first (in closed form, see isotropic_hessian.hpp).
   void stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const;
   /// The stiffness sparsity pattern (values zero), column-major, 3·#V square.
   const SparseMatrixd& stiffness_pattern() const { return m_pattern; }
