@@ -8,7 +8,10 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
   const std::string where = scene.file.string() + ": mesh";
   PreparedMesh prepared;
   try {
-    if (scene.mesh.file) {
+    if (scene.mesh.surface) {
+      throw InputError(scene.mesh.surface->string() +
+                       ": tetrahedralising a surface is not available yet");
+    } else if (scene.mesh.file) {
       prepared.source = scene.mesh.file->string();
       prepared.mesh = read_tet_mesh(*scene.mesh.file);
     } else {
@@ -17,7 +20,8 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
     }
     validate_tet_mesh(prepared.mesh, prepared.source);
   } catch (const InputError& error) {
-    throw InputError(where + (scene.mesh.file ? ".file: " : ".box: ") + error.what());
+    const char* key = scene.mesh.surface ? ".surface: " : scene.mesh.file ? ".file: " : ".box: ";
+    throw InputError(where + key + error.what());
   }
   prepared.removed_vertices = remove_unreferenced_vertices(prepared.mesh);
   prepared.reoriented_tets = orient_tets(prepared.mesh);

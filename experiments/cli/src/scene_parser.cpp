@@ -41,16 +41,66 @@ Region parse_region(const SceneValue& value) {
   return SphereRegion{sphere.at("center").vec3(), sphere.at("radius").non_negative()};
 }
 
+std::filesystem::path parse_path(const SceneValue& value, const std::filesystem::path& folder) {
+  const std::string name = value.string();
+  if (name.empty()) value.fail("must not be empty");
+  const std::filesystem::path path(name);
+  return path.is_absolute() ? path : folder / path;
+}
+
+/// The Mesh_3 keys beside "surface".
+MeshingOptions parse_meshing_options(const SceneValue& value) {
+  MeshingOptions options;
+  options.cell_size = value.at("cell_size").positive();
+  if (value.has("facet_size")) options.facet_size = value.at("facet_size").positive();
+  if (value.has("facet_distance")) options.facet_distance = value.at("facet_distance").positive();
+  if (value.has("facet_angle")) {
+    const SceneValue angle = value.at("facet_angle");
+    options.facet_angle = angle.number();
+    if (options.facet_angle <= 0.0 || options.facet_angle > 30.0) {
+      angle.fail("must be in (0, 30] degrees (Mesh_3 need not terminate above 30)");
+    }
+  }
+  if (value.has("radius_edge_ratio")) {
+    const SceneValue ratio = value.at("radius_edge_ratio");
+    options.cell_radius_edge_ratio = ratio.number();
+    if (options.cell_radius_edge_ratio < 2.0) {
+      ratio.fail("must be >= 2 (Mesh_3 need not terminate below 2)");
+    }
+  }
+  if (value.has("sharp_features")) options.sharp_features = value.at("sharp_features").boolean();
+  if (value.has("perturb")) options.perturb = value.at("perturb").boolean();
+  if (value.has("exude")) options.exude = value.at("exude").boolean();
+  if (value.has("odt")) options.odt = value.at("odt").boolean();
+  if (value.has("lloyd")) options.lloyd = value.at("lloyd").boolean();
+  if (value.has("seed")) options.seed = static_cast<std::uint32_t>(value.at("seed").integer(0));
+  return options;
+}
+
 MeshSpec parse_mesh(const SceneValue& value, const std::filesystem::path& folder) {
-  value.expect_object({"file", "box"});
-  if (value.has("file") == value.has("box")) value.fail("must have exactly one of file, box");
+  value.expect_object({"file", "box", "surface", "cell_size", "facet_size", "facet_distance",
+                       "facet_angle", "radius_edge_ratio", "sharp_features", "perturb", "exude",
+                       "odt", "lloyd", "seed"});
+  if (!value.has("file") && !value.has("box") && !value.has("surface")) {
+    value.fail("must have one of file, box, surface");
+  }
+  if (value.has("surface") && (value.has("file") || value.has("box"))) {
+    value.fail("surface excludes file and box");
+  }
+  if (value.has("file") && value.has("box")) value.fail("must have exactly one of file, box");
   MeshSpec mesh;
+  if (value.has("surface")) {
+    mesh.surface = parse_path(value.at("surface"), folder);
+    mesh.meshing = parse_meshing_options(value);
+    return mesh;
+  }
+  for (const char* key :
+       {"cell_size", "facet_size", "facet_distance", "facet_angle", "radius_edge_ratio",
+        "sharp_features", "perturb", "exude", "odt", "lloyd", "seed"}) {
+    if (value.has(key)) value.at(key).fail("is a meshing key: only allowed with surface");
+  }
   if (value.has("file")) {
-    const SceneValue file = value.at("file");
-    const std::string name = file.string();
-    if (name.empty()) file.fail("must not be empty");
-    const std::filesystem::path path(name);
-    mesh.file = path.is_absolute() ? path : folder / path;
+    mesh.file = parse_path(value.at("file"), folder);
     return mesh;
   }
   const SceneValue box = value.at("box");

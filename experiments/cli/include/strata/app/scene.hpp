@@ -1,7 +1,8 @@
 #pragma once
 /// \file scene.hpp
-/// A simulation scene as read from a scene file (README.md, "Scene file and CLI reference", documents every key). Plain
-/// data in the core's own types: parsing lives in scene_parser.hpp, running in scene_runner.hpp.
+/// A simulation scene as read from a scene file (README.md, "Scene file and CLI reference",
+/// documents every key). Plain data in the core's own types: parsing lives in scene_parser.hpp,
+/// running in scene_runner.hpp.
 #include <array>
 #include <filesystem>
 #include <optional>
@@ -14,15 +15,20 @@
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/solver_settings.hpp"
+#include "strata/meshing/meshing_options.hpp"
 
 namespace strata::app {
 
-/// "mesh": either a mesh file or a procedural box.
+/// "mesh": a tet mesh file, a procedural box, or a surface to tetrahedralise.
 struct MeshSpec {
   std::optional<std::filesystem::path> file;  ///< absolute, or relative to the working folder
-  Vector3d box_min = Vector3d::Zero();        ///< used when `file` is empty [m]
-  Vector3d box_max = Vector3d::Ones();        ///< [m]
-  std::array<int, 3> box_cells{1, 1, 1};      ///< hexahedral cells per axis (6 tets each)
+  /// Closed surface (.off, .obj, .ply, .stl) meshed with CGAL Mesh_3 using `meshing`; absolute, or
+  /// relative to the working folder.
+  std::optional<std::filesystem::path> surface;
+  MeshingOptions meshing;                 ///< used when `surface` is set
+  Vector3d box_min = Vector3d::Zero();    ///< used when `file` is empty [m]
+  Vector3d box_max = Vector3d::Ones();    ///< [m]
+  std::array<int, 3> box_cells{1, 1, 1};  ///< hexahedral cells per axis (6 tets each)
 };
 
 /// "output".
