@@ -1,6 +1,9 @@
 #pragma once
 // Shared helpers of the refinement-criteria tests: a CutState built from prescribed displacement
 // fields and finest-level point loads on a flattened cut, as the adaptive driver would fill it.
+#include <gtest/gtest.h>
+
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -92,6 +95,58 @@ inline CutSnapshot make_snapshot(const ActiveCut& cut, const Material& material,
 /// No displacement.
 inline Vector3d no_motion(const Vector3d&) {
   return Vector3d::Zero();
+}
+
+/// The test slab [0, 1] × [0, 1] × [0, 0.25] (times `scale`), 6 × 6 × 2 cells, 432 tets.
+inline const Vector3d kSlabMax(1.0, 1.0, 0.25);
+
+inline TetMesh slab(double scale = 1.0) {
+  return box_tet_mesh(Vector3d::Zero(), scale * kSlabMax, {6, 6, 2});
+}
+
+inline Material test_material(double youngs_modulus = 1e6) {
+  Material m;
+  m.model = MaterialModel::neohookean;
+  m.youngs_modulus = youngs_modulus;
+  m.poisson_ratio = 0.3;
+  m.density = 1000.0;
+  return m;
+}
+
+inline Matrix3d affine_gradient() {
+  Matrix3d G;
+  G << 0.02, 0.01, -0.005,  //
+      0.003, -0.01, 0.004,  //
+      0.0, 0.006, 0.015;
+  return G;
+}
+
+// A smooth bump of the top surface around `centre` (same strain at every scale s when lengths
+// scale by s).
+inline DisplacementField bump(const Vector3d& centre, double radius, double depth) {
+  return [=](const Vector3d& X) -> Vector3d {
+    const double r2 = (X - centre).squaredNorm() / (radius * radius);
+    return Vector3d(0.0, 0.0, -depth * std::exp(-r2));
+  };
+}
+
+inline bool on_slab_surface(const Vector3d& X, double scale = 1.0) {
+  for (int d = 0; d < 3; ++d)
+    if (std::abs(X[d]) < 1e-12 || std::abs(X[d] - scale * kSlabMax[d]) < 1e-12) return true;
+  return false;
+}
+
+// Tractions of the current stress: minus the elastic force at the body's surface vertices.
+inline void set_surface_tractions(CutSnapshot& s, const Vector3d& gravity) {
+  const TetMesh& mesh = s.cut.flat.mesh;
+  const ElasticModel model(mesh.vertices, mesh.tets, s.material);
+  VectorXd f;
+  model.forces(s.positions, f);
+  for (Index v = 0; v < mesh.vertices.rows(); ++v) {
+    const bool surface = on_slab_surface(mesh.vertices.row(v).transpose());
+    s.external_forces.segment<3>(3 * v) =
+        s.vertex_mass[v] * gravity - (surface ? Vector3d(f.segment<3>(3 * v)) : Vector3d::Zero());
+  }
 }
 
 /// Rest centroid of a node.

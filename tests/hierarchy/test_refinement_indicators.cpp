@@ -11,41 +11,15 @@
 namespace strata {
 namespace {
 
+using test::affine_gradient;
+using test::bump;
+using test::kSlabMax;
 using test::make_snapshot;
 using test::node_centroid;
 using test::PointLoad;
-
-const Vector3d kSlabMax(1.0, 1.0, 0.25);
-
-TetMesh slab(double scale = 1.0) {
-  return box_tet_mesh(Vector3d::Zero(), scale * kSlabMax, {6, 6, 2});
-}
-
-Material test_material(double youngs_modulus = 1e6) {
-  Material m;
-  m.model = MaterialModel::neohookean;
-  m.youngs_modulus = youngs_modulus;
-  m.poisson_ratio = 0.3;
-  m.density = 1000.0;
-  return m;
-}
-
-Matrix3d affine_gradient() {
-  Matrix3d G;
-  G << 0.02, 0.01, -0.005,  //
-      0.003, -0.01, 0.004,  //
-      0.0, 0.006, 0.015;
-  return G;
-}
-
-// A smooth bump of the top surface around `centre` (same strain at every scale s when lengths
-// scale by s).
-test::DisplacementField bump(const Vector3d& centre, double radius, double depth) {
-  return [=](const Vector3d& X) -> Vector3d {
-    const double r2 = (X - centre).squaredNorm() / (radius * radius);
-    return Vector3d(0.0, 0.0, -depth * std::exp(-r2));
-  };
-}
+using test::set_surface_tractions;
+using test::slab;
+using test::test_material;
 
 // The mixed cut used throughout: a few roots refined, one child refined again.
 ActiveCut mixed_cut(TetTree& tree) {
@@ -54,25 +28,6 @@ ActiveCut mixed_cut(TetTree& tree) {
     cut.refine(r);
   cut.refine(tree.child(40, 2));
   return cut;
-}
-
-bool on_slab_surface(const Vector3d& X, double scale = 1.0) {
-  for (int d = 0; d < 3; ++d)
-    if (std::abs(X[d]) < 1e-12 || std::abs(X[d] - scale * kSlabMax[d]) < 1e-12) return true;
-  return false;
-}
-
-// Tractions of the current stress: minus the elastic force at the body's surface vertices.
-void set_surface_tractions(test::CutSnapshot& s, const Vector3d& gravity) {
-  const TetMesh& mesh = s.cut.flat.mesh;
-  const ElasticModel model(mesh.vertices, mesh.tets, s.material);
-  VectorXd f;
-  model.forces(s.positions, f);
-  for (Index v = 0; v < mesh.vertices.rows(); ++v) {
-    const bool surface = on_slab_surface(mesh.vertices.row(v).transpose());
-    s.external_forces.segment<3>(3 * v) =
-        s.vertex_mass[v] * gravity - (surface ? Vector3d(f.segment<3>(3 * v)) : Vector3d::Zero());
-  }
 }
 
 TEST(ForceIndicator, UniformStressWithItsTractionsStaysAtOrBelowOne) {
