@@ -1,0 +1,176 @@
+#pragma once
+/// \file adaptive_simulation.hpp
+/// The multiresolution driver: a core Simulation on an active cut of the refinement tree, with the
+/// cut chosen by a mode —
+///   - full:     every node at the tree's deepest level (the reference resolution);
+///   - uniform:  every node at one level k;
+///   - adaptive: starting at level k, refined where the criteria ask (refinement_controller.hpp)
+///               and coarsened where children's stresses agree —
+/// all through the same code path: flatten the cut (tree_flatten.hpp), build its hanging-vertex
+/// embedding x = C q (hanging_constraints.hpp), and run core's Simulation on q with every
+/// integrator and the static solver unchanged (SimulationOptions). A scene therefore means the same
+/// thing on every cut: loads, fixed and prescribed regions and probes are defined on the finest
+/// level (finest_level.hpp).
+///
+/// Lifecycle of an adaptive step (dynamic runs: every `adapt_every` steps; static runs: after
+/// every load step, up to `max_passes` solve–mark–refine passes per load step, re-solving the same
+/// load factor on the new cut):
+///   advance the Simulation → CutState (positions, stresses, loads) → controller.decide → drop
+///   coarsenings that would make a Dirichlet group inexact → controller.apply (cut edits) →
+///   flatten + constraints of the new cut → carry positions and velocities through the tree's
+///   vertices (cut_transfer.hpp: new vertices take the parent's linear field, so no energy jump on
+///   refinement) → release coarsened subtrees (memory follows the active cut) → a new Simulation
+///   that continues the clock (first_step) from the transferred state.
+///
+/// Explicit integrators: refinement of a node is refused (vetoed) when its children's stable step
+/// estimate (stable_time_step.hpp) falls below the scene's dt; the time step is never changed, so
+/// outputs stay on the scene's time grid. Implicit integrators and static runs refine freely.
+///
+/// Fixed and prescribed regions stay exact: before the run, active tets on which a group is not
+/// exact are refined until it is, and such parents are never coarsened into (finest_level.hpp).
+///
+/// Energy at transfers: kinetic + elastic energy just before and just after each cut change is
+/// recorded (`changes()`). Refinement keeps the elastic energy exactly (the new vertices lie on the
+/// old linear field); coarsening loses the elastic energy of the fine detail the parent cannot
+/// represent. Kinetic energy: lumped masses of the same linear velocity field differ between
+/// cuts (momentum does not), so within the changed region the velocities' deviation from the
+/// region's mean velocity is rescaled to keep ½ Σ m v² and the momentum exactly.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "strata/core/sim/simulation.hpp"
+#include "strata/hierarchy/active_cut.hpp"
+#include "strata/hierarchy/finest_level.hpp"
+#include "strata/hierarchy/hanging_constraints.hpp"
+#include "strata/hierarchy/refinement_controller.hpp"
+#include "strata/hierarchy/tree_point_location.hpp"
+
+namespace strata {
+
+enum class HierarchyMode { full, uniform, adaptive };
+
+/// "full" / "uniform" / "adaptive".
+std::string to_string(HierarchyMode mode);
+
+/// Settings of the hierarchy (scene key "hierarchy").
+struct HierarchySettings {
+  int levels = 1;                                ///< L: red-refinement levels below the coarse mesh
+  HierarchyMode mode = HierarchyMode::adaptive;  ///<
+  int level = 0;                    ///< uniform: the level k; adaptive: the starting level
+  int adapt_every = 10;             ///< dynamic: steps between two evaluations of the criteria
+  int max_passes = 4;               ///< static: solve–mark–refine passes per load step (≥ 1)
+  std::string indicator = "force";  ///< "force" or "stress_jump"
+  RefinementSettings criteria;      ///< thresholds and hysteresis
+};
+
+/// Throws InputError naming `where` ("hierarchy") and the key for invalid settings: levels ∉ 0..8,
+/// level ∉ 0..levels, adapt_every < 1, max_passes < 1, an unknown indicator, invalid criteria.
+void validate_hierarchy_settings(const HierarchySettings& settings, const std::string& where);
+
+/// One change of the active cut.
+struct CutChangeRecord {
+  long step = 0;                          ///< after this step (static: load step) …
+  int pass = 0;                           ///< … and this pass (static; 0 in dynamic runs)
+  double time = 0.0;                      ///< simulated time or load factor
+  Index refined = 0;                      ///< nodes refined (including 2:1 balance)
+  Index coarsened = 0;                    ///< parents coarsened
+  Index tets_before = 0, tets_after = 0;  ///< active tets
+  Index dofs_after = 0;                   ///< 3·#free vertices after the change
+  double energy_before = 0.0;             ///< kinetic + elastic energy just before the change [J]
+  double energy_after = 0.0;              ///< … just after (state transferred) [J]
+  double seconds = 0.0;  ///< wall time of the change (decide, edit, flatten, rebuild)
+};
+
+/// The active cut after a step.
+struct CutSample {
+  long step = 0;
+  double time = 0.0;  ///< simulated time or load factor
+  Index tets = 0;     ///< active tets
+  Index dofs = 0;     ///< 3·#free vertices
+  Index hanging = 0;  ///< hanging vertices
+};
+
+class AdaptiveSimulation {
+ public:
+  /// `coarse`: the roots (validated and oriented by the caller, as for Simulation). The region
+  /// loads are applied on the finest level; gravity, Dirichlet groups, ground and solver settings
+  /// as in Simulation. Throws InputError for invalid settings or scene data.
+  AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
+                     const Material& material, std::vector<DirichletSpec> dirichlet,
+                     const std::vector<RegionLoad>& loads, std::optional<GroundPlane> ground,
+                     const Vector3d& gravity, const SolverSettings& settings);
+  ~AdaptiveSimulation();
+  AdaptiveSimulation(const AdaptiveSimulation&) = delete;
+  AdaptiveSimulation& operator=(const AdaptiveSimulation&) = delete;
+
+  /// One time step (or load step), then the criteria if due. Throws DivergenceError as Simulation.
+  void advance();
+  bool finished() const { return m_simulation->finished(); }
+  double time() const { return m_simulation->time(); }
+  long step_count() const { return m_simulation->step_count(); }
+
+  /// The Simulation on the current cut (mesh = flat().mesh; rebuilt at every cut change).
+  const Simulation& simulation() const { return *m_simulation; }
+  const TetTree& tree() const { return *m_tree; }
+  const ActiveCut& cut() const { return *m_cut; }
+  /// The current cut as a mesh, with its tree maps.
+  const FlatTreeMesh& flat() const { return m_constrained->flat; }
+  const HangingConstraints& constraints() const { return m_constrained->constraints; }
+  /// Tree level of each active tet (#T of flat().mesh).
+  VectorXi cell_levels() const;
+  const HierarchySettings& settings() const { return m_settings; }
+  const RefinementController& controller() const { return *m_controller; }
+
+  /// Material points at rest positions `points` (n × 3), each located in its root; throws
+  /// InputError naming the point (`where`[i]) if a point is outside the coarse mesh (beyond 10⁻⁶
+  /// of its bounding-box diagonal).
+  std::vector<RootPoint> locate(ConstRef<MatrixX3d> points, const std::string& where) const;
+  /// Displacements (n × 3) of material points on the current cut, interpolated in the active
+  /// ancestor of the leaf that contains each.
+  MatrixX3d displacements(const std::vector<RootPoint>& points) const;
+
+  /// Every cut change so far, and the cut after every step (plus the initial cut as step 0).
+  const std::vector<CutChangeRecord>& changes() const { return m_changes; }
+  const std::vector<CutSample>& history() const { return m_history; }
+  /// Work summed over every Simulation of the run.
+  SimulationCounters counters() const;
+  /// Wall time spent in cut changes (bookkeeping) and in Simulation::advance [s].
+  double bookkeeping_seconds() const { return m_bookkeeping_seconds; }
+  double stepping_seconds() const { return m_stepping_seconds; }
+
+ private:
+  void make_dirichlet_exact();
+  void rebuild(long first_step);
+  bool adapt(int pass);
+  bool children_stable(NodeId n) const;
+  void record_sample();
+  void keep_kinetic_energy(const FlatTreeMesh& old_flat, const HangingConstraints& old_constraints,
+                           const Simulation& old_simulation);
+
+  HierarchySettings m_settings;
+  Material m_material;
+  std::vector<DirichletSpec> m_dirichlet;
+  std::optional<GroundPlane> m_ground;
+  Vector3d m_gravity;
+  SolverSettings m_solver;
+  double m_tolerance = 0.0;
+
+  std::unique_ptr<TetTree> m_tree;
+  std::unique_ptr<ActiveCut> m_cut;
+  std::unique_ptr<TreePointLocator> m_locator;
+  std::unique_ptr<RefinementController> m_controller;
+  std::vector<PointLoad> m_point_loads;
+  std::unique_ptr<ConstrainedCut> m_constrained;
+  VectorXd m_mesh_external;  ///< 3·#V of the current cut: gravity + mapped point loads
+  std::unique_ptr<Simulation> m_simulation;
+
+  std::vector<CutChangeRecord> m_changes;
+  std::vector<CutSample> m_history;
+  SimulationCounters m_finished_counters;  ///< of the Simulations already replaced
+  double m_bookkeeping_seconds = 0.0;
+  double m_stepping_seconds = 0.0;
+};
+
+}  // namespace strata

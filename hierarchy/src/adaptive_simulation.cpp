@@ -1,0 +1,334 @@
+#include "strata/hierarchy/adaptive_simulation.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/region.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
+#include "strata/hierarchy/cut_state.hpp"
+#include "strata/hierarchy/cut_transfer.hpp"
+#include "strata/hierarchy/red_refinement.hpp"
+#include "strata/hierarchy/refinement_force_indicator.hpp"
+#include "strata/hierarchy/refinement_stress_jump_indicator.hpp"
+
+namespace strata {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool is_static(const SolverSettings& settings) {
+  return settings.mode == SimulationMode::static_equilibrium;
+}
+
+bool is_explicit(const SolverSettings& settings) {
+  return !is_static(settings) && settings.integrator != Integrator::implicit_euler;
+}
+
+std::unique_ptr<RefinementIndicator> make_indicator(const HierarchySettings& settings) {
+  if (settings.indicator == "stress_jump")
+    return std::make_unique<StressJumpIndicator>(settings.criteria.stress_floor);
+  return std::make_unique<ForceIndicator>(settings.criteria.stress_floor);
+}
+
+SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
+  a.steps += b.steps;
+  a.newton_iterations += b.newton_iterations;
+  a.element_evaluations += b.element_evaluations;
+  a.factorizations += b.factorizations;
+  return a;
+}
+
+}  // namespace
+
+std::string to_string(HierarchyMode mode) {
+  switch (mode) {
+    case HierarchyMode::full:
+      return "full";
+    case HierarchyMode::uniform:
+      return "uniform";
+    case HierarchyMode::adaptive:
+      return "adaptive";
+  }
+  return "?";
+}
+
+void validate_hierarchy_settings(const HierarchySettings& settings, const std::string& where) {
+  if (settings.levels < 0 || settings.levels > 8)
+    throw InputError(where + ".levels: must be in 0..8, got " + std::to_string(settings.levels));
+  if (settings.level < 0 || settings.level > settings.levels)
+    throw InputError(where + ".level: must be in 0.." + std::to_string(settings.levels) +
+                     " (levels), got " + std::to_string(settings.level));
+  if (settings.adapt_every < 1) throw InputError(where + ".adapt_every: must be >= 1");
+  if (settings.max_passes < 1) throw InputError(where + ".max_passes: must be >= 1");
+  if (settings.indicator != "force" && settings.indicator != "stress_jump")
+    throw InputError(where + ".indicator: expected \"force\" or \"stress_jump\", got \"" +
+                     settings.indicator + "\"");
+  validate_refinement_settings(settings.criteria, where);
+}
+
+AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
+                                       const Material& material,
+                                       std::vector<DirichletSpec> dirichlet,
+                                       const std::vector<RegionLoad>& loads,
+                                       std::optional<GroundPlane> ground, const Vector3d& gravity,
+                                       const SolverSettings& settings)
+    : m_settings(hierarchy),
+      m_material(material),
+      m_dirichlet(std::move(dirichlet)),
+      m_ground(std::move(ground)),
+      m_gravity(gravity),
+      m_solver(settings) {
+  validate_hierarchy_settings(m_settings, "hierarchy");
+  validate_material(m_material, "material");
+  validate_solver_settings(m_solver, "solver");
+  if (!m_gravity.allFinite()) throw InputError("gravity: must be finite");
+  for (const DirichletSpec& group : m_dirichlet)
+    validate_region(group.region, group.name + ".region");
+  const auto start = Clock::now();
+  m_tree = std::make_unique<TetTree>(coarse, m_settings.levels);
+  m_tolerance = region_tolerance(coarse.vertices);
+  const int start_level =
+      m_settings.mode == HierarchyMode::full ? m_settings.levels : m_settings.level;
+  m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, start_level));
+  m_locator = std::make_unique<TreePointLocator>(*m_tree);
+  m_controller =
+      std::make_unique<RefinementController>(m_settings.criteria, make_indicator(m_settings));
+  if (is_explicit(m_solver))
+    m_controller->set_refinement_veto([this](NodeId n) { return children_stable(n); });
+  m_point_loads = finest_level_loads(*m_tree, loads, m_tolerance);
+  make_dirichlet_exact();
+  rebuild(0);
+  m_bookkeeping_seconds += seconds_since(start);
+  record_sample();
+}
+
+AdaptiveSimulation::~AdaptiveSimulation() = default;
+
+void AdaptiveSimulation::make_dirichlet_exact() {
+  // Each pass refines the offending tets one level; at the deepest level every group is exact.
+  for (int pass = 0; pass <= m_tree->max_level(); ++pass) {
+    const std::vector<NodeId> offenders = inexact_dirichlet_nodes(*m_cut, m_dirichlet, m_tolerance);
+    if (offenders.empty()) return;
+    for (NodeId n : offenders)
+      m_cut->refine(n);
+  }
+}
+
+bool AdaptiveSimulation::children_stable(NodeId n) const {
+  // The eight children as a mesh of their own: its lumped masses are at most those of the
+  // children in any cut, so its estimate is a lower bound of theirs (refusal errs on the safe
+  // side).
+  const std::array<Matrix3x4d, 8> children = red_refine_tet(m_tree->bey_positions(n));
+  TetMesh mesh;
+  mesh.vertices.resize(32, 3);
+  mesh.tets.resize(8, 4);
+  for (int k = 0; k < 8; ++k) {
+    Matrix3x4d x = children[k];
+    if ((x.col(1) - x.col(0)).cross(x.col(2) - x.col(0)).dot(x.col(3) - x.col(0)) < 0.0)
+      x.col(2).swap(x.col(3));
+    for (int c = 0; c < 4; ++c) {
+      mesh.vertices.row(4 * k + c) = x.col(c).transpose();
+      mesh.tets(k, c) = 4 * k + c;
+    }
+  }
+  return stable_time_step_estimate(mesh.vertices, mesh.tets, m_material, m_solver.integrator) >=
+         m_solver.dt;
+}
+
+void AdaptiveSimulation::rebuild(long first_step) {
+  m_constrained = std::make_unique<ConstrainedCut>(flatten_cut(*m_cut));
+  const FlatTreeMesh& flat = m_constrained->flat;
+  const HangingConstraints& constraints = m_constrained->constraints;
+  SimulationOptions options;
+  options.vertex_embedding = constraints.matrix();
+  options.dof_vertices = constraints.free_vertices();
+  options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads);
+  options.first_step = first_step;
+  m_mesh_external = options.extra_mesh_forces;
+  m_simulation =
+      std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet, std::vector<RegionLoad>{},
+                                   m_ground, m_gravity, m_solver, std::move(options));
+  m_mesh_external += gravity_forces(m_simulation->vertex_mass(), m_gravity);
+}
+
+void AdaptiveSimulation::advance() {
+  const auto start = Clock::now();
+  m_simulation->advance();
+  m_stepping_seconds += seconds_since(start);
+  if (m_settings.mode == HierarchyMode::adaptive) {
+    if (is_static(m_solver)) {
+      // Solve–mark–refine: re-solve the same load factor on each new cut.
+      for (int pass = 0; pass < m_settings.max_passes && adapt(pass); ++pass) {
+        const auto solve_start = Clock::now();
+        m_simulation->advance();
+        m_stepping_seconds += seconds_since(solve_start);
+      }
+    } else if (step_count() % m_settings.adapt_every == 0 && !finished()) {
+      adapt(0);
+    }
+  }
+  record_sample();
+}
+
+bool AdaptiveSimulation::adapt(int pass) {
+  const auto start = Clock::now();
+  const Simulation& sim = *m_simulation;
+  const FlatTreeMesh& flat = m_constrained->flat;
+  const TetFields fields = sim.model().tet_fields(sim.positions());
+  const CutState state{*m_tree,           flat,       sim.positions(), fields, m_mesh_external,
+                       sim.vertex_mass(), m_material, sim.step_count()};
+  CutChanges changes = m_controller->decide(state, *m_cut);
+  // Keep Dirichlet groups exact: never coarsen into a parent on which one would not be.
+  std::erase_if(changes.coarsen, [&](NodeId parent) {
+    return !dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
+  });
+  if (changes.refine.empty() && changes.coarsen.empty()) {
+    m_bookkeeping_seconds += seconds_since(start);
+    return false;
+  }
+
+  CutChangeRecord record;
+  record.step = sim.step_count();
+  record.pass = pass;
+  record.time = sim.time();
+  record.tets_before = m_cut->size();
+  record.energy_before = sim.kinetic_energy() + sim.elastic_energy();
+  const VectorXd old_positions = sim.positions();
+  const VectorXd old_velocities = sim.velocities();
+  const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
+  record.refined = counts.refined + counts.balance_refined;
+  record.coarsened = counts.coarsened;
+
+  // Restart on the new cut from the same step: static runs re-solve the load step just taken.
+  const long first_step = is_static(m_solver) ? sim.step_count() - 1 : sim.step_count();
+  std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
+  std::unique_ptr<Simulation> old_simulation = std::move(m_simulation);
+  m_finished_counters = add(m_finished_counters, old_simulation->counters());
+  rebuild(first_step);
+  const FlatTreeMesh& new_flat = m_constrained->flat;
+  const HangingConstraints& constraints = m_constrained->constraints;
+  const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
+  const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
+  m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
+  keep_kinetic_energy(old_cut->flat, old_cut->constraints, *old_simulation);
+  old_simulation.reset();
+  old_cut.reset();
+  for (NodeId parent : changes.coarsen)
+    if (m_cut->is_active(parent)) m_tree->coarsen_subtree(parent);  // memory follows the cut
+
+  record.tets_after = m_cut->size();
+  record.dofs_after = m_simulation->embedded_model().num_dofs();
+  record.energy_after = m_simulation->kinetic_energy() + m_simulation->elastic_energy();
+  record.seconds = seconds_since(start);
+  m_bookkeeping_seconds += record.seconds;
+  m_changes.push_back(record);
+  return true;
+}
+
+void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
+                                             const HangingConstraints& old_constraints,
+                                             const Simulation& old_simulation) {
+  // Lumped masses of the same linear velocity field differ between cuts, so the transferred
+  // velocities carry a different kinetic energy (momentum is the same: Σ m_i v_i = ∫ρ v_h for
+  // lumped masses of any cut). Within the changed region S (DOF vertices that are new or whose
+  // mass changed, none of them prescribed) the deviation from S's mean velocity is scaled by s so
+  // that ½ Σ m v² matches the old value; S's momentum, hence the total, is unchanged.
+  const FlatTreeMesh& flat = m_constrained->flat;
+  const HangingConstraints& constraints = m_constrained->constraints;
+  std::vector<double> old_mass(m_tree->vertex_capacity(), -1.0);
+  const VectorXd& old_dof_mass = old_simulation.dof_vertex_mass();
+  for (size_t q = 0; q < old_constraints.free_vertices().size(); ++q)
+    old_mass[old_flat.tree_vertices[old_constraints.free_vertices()[q]]] = old_dof_mass[q];
+  const VectorXd& mass = m_simulation->dof_vertex_mass();
+  std::vector<char> prescribed(mass.size(), 0);
+  for (const DirichletGroup& group : m_simulation->dirichlet_groups())
+    for (int q : group.vertices)
+      prescribed[q] = 1;
+  std::vector<Index> changed;
+  for (Index q = 0; q < mass.size(); ++q) {
+    const double before = old_mass[flat.tree_vertices[constraints.free_vertices()[q]]];
+    if (!prescribed[q] && std::abs(before - mass[q]) > 1e-12 * mass[q]) changed.push_back(q);
+  }
+  if (changed.empty()) return;
+  VectorXd v = m_simulation->dof_velocities();
+  double region_mass = 0.0, region_energy = 0.0;
+  Vector3d momentum = Vector3d::Zero();
+  for (Index q : changed) {
+    region_mass += mass[q];
+    momentum += mass[q] * v.segment<3>(3 * q);
+    region_energy += 0.5 * mass[q] * v.segment<3>(3 * q).squaredNorm();
+  }
+  const Vector3d mean = momentum / region_mass;
+  double deviation = 0.0;
+  for (Index q : changed)
+    deviation += mass[q] * (v.segment<3>(3 * q) - mean).squaredNorm();
+  const double target = old_simulation.kinetic_energy() -
+                        (m_simulation->kinetic_energy() - region_energy) -
+                        0.5 * region_mass * mean.squaredNorm();
+  if (!(deviation > 0.0) || target < 0.0) return;  // cannot be matched by a scale: keep linear
+  const double scale = std::sqrt(2.0 * target / deviation);
+  for (Index q : changed)
+    v.segment<3>(3 * q) = mean + scale * (v.segment<3>(3 * q) - mean);
+  const VectorXd q = m_simulation->dof_positions();
+  m_simulation->set_state(q, v);
+}
+
+void AdaptiveSimulation::record_sample() {
+  CutSample sample;
+  sample.step = m_simulation->step_count();
+  sample.time = m_simulation->time();
+  sample.tets = m_cut->size();
+  sample.dofs = m_simulation->embedded_model().num_dofs();
+  sample.hanging = m_constrained->constraints.num_hanging();
+  m_history.push_back(sample);
+}
+
+VectorXi AdaptiveSimulation::cell_levels() const {
+  const FlatTreeMesh& flat = m_constrained->flat;
+  VectorXi levels(static_cast<Index>(flat.tet_nodes.size()));
+  for (Index t = 0; t < levels.size(); ++t)
+    levels[t] = m_tree->level(flat.tet_nodes[t]);
+  return levels;
+}
+
+std::vector<RootPoint> AdaptiveSimulation::locate(ConstRef<MatrixX3d> points,
+                                                  const std::string& where) const {
+  const auto [lo, hi] = bounding_box(m_constrained->flat.mesh.vertices);
+  const double tolerance = 1e-6 * (hi - lo).norm();
+  std::vector<RootPoint> located;
+  for (Index i = 0; i < points.rows(); ++i) {
+    const Vector3d p = points.row(i).transpose();
+    const std::optional<TreeLocation> root = m_locator->locate_root(p, tolerance);
+    if (!root) throw InputError(where + "[" + std::to_string(i) + "]: point lies outside the mesh");
+    located.push_back({root->node, p});
+  }
+  return located;
+}
+
+MatrixX3d AdaptiveSimulation::displacements(const std::vector<RootPoint>& points) const {
+  const FlatTreeMesh& flat = m_constrained->flat;
+  const VectorXd& x = m_simulation->positions();
+  MatrixX3d result(static_cast<Index>(points.size()), 3);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const CutPointWeights w = embed_point(*m_cut, flat, points[i]);
+    Vector3d u = Vector3d::Zero();
+    for (int k = 0; k < 4; ++k)
+      u += w.weights[k] *
+           (x.segment<3>(3 * w.vertices[k]) - flat.mesh.vertices.row(w.vertices[k]).transpose());
+    result.row(static_cast<Index>(i)) = u.transpose();
+  }
+  return result;
+}
+
+SimulationCounters AdaptiveSimulation::counters() const {
+  return add(m_finished_counters, m_simulation->counters());
+}
+
+}  // namespace strata

@@ -1,0 +1,280 @@
+// The multiresolution driver: full and uniform modes against core's Simulation on the same meshes
+// (independent path), finest-level loads and Dirichlet regions, adaptive accuracy against the full
+// resolution, energy at refinement, and the explicit step limit.
+#include <gtest/gtest.h>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/region.hpp"
+#include "strata/hierarchy/adaptive_simulation.hpp"
+#include "strata/hierarchy/finest_level.hpp"
+#include "strata/hierarchy/tree_flatten.hpp"
+
+namespace strata {
+namespace {
+
+Material rubber() {
+  Material material;
+  material.model = MaterialModel::neohookean;
+  material.youngs_modulus = 1e6;
+  material.poisson_ratio = 0.3;
+  material.density = 1000.0;
+  return material;
+}
+
+SolverSettings static_settings(int load_steps) {
+  SolverSettings settings;
+  settings.mode = SimulationMode::static_equilibrium;
+  settings.load_steps = load_steps;
+  return settings;
+}
+
+DirichletSpec fixed_plane(const std::string& name, const Vector3d& point, const Vector3d& normal) {
+  DirichletSpec spec;
+  spec.name = name;
+  spec.region = PlaneRegion{point, normal, 0.0};
+  return spec;
+}
+
+RegionLoad box_load(const Vector3d& lo, const Vector3d& hi, const Vector3d& force) {
+  RegionLoad load;
+  load.name = "forces.0";
+  load.region = BoxRegion{lo, hi};
+  load.total_force = force;
+  return load;
+}
+
+/// A 1 × 0.25 × 0.25 bar clamped at x = 0 with a shear load on its end face.
+struct Bar {
+  TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 0.25, 0.25), {4, 1, 1});
+  std::vector<DirichletSpec> fixed = {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX())};
+  std::vector<RegionLoad> loads = {
+      box_load(Vector3d(1, -1, -1), Vector3d(1, 1, 1), Vector3d(0, 0, -200.0))};
+  Vector3d gravity = Vector3d(0, 0, -9.81);
+};
+
+HierarchySettings hierarchy(int levels, HierarchyMode mode, int level = 0) {
+  HierarchySettings settings;
+  settings.levels = levels;
+  settings.mode = mode;
+  settings.level = level;
+  return settings;
+}
+
+template <typename Sim>
+void run(Sim& sim) {
+  while (!sim.finished())
+    sim.advance();
+}
+
+TEST(AdaptiveSimulation, FullModeEqualsCoreOnTheLeafMesh) {
+  const Bar bar;
+  AdaptiveSimulation adaptive(bar.coarse, hierarchy(1, HierarchyMode::full), rubber(), bar.fixed,
+                              bar.loads, std::nullopt, bar.gravity, static_settings(2));
+  run(adaptive);
+  // Independent path: core's Simulation on the flattened leaves, loads spread by core itself.
+  TetTree tree(bar.coarse, 1);
+  for (NodeId r = 0; r < tree.num_roots(); ++r)
+    tree.refine(r);
+  const FlatTreeMesh leaves = flatten_leaves(tree);
+  Simulation reference(leaves.mesh, rubber(), bar.fixed, bar.loads, std::nullopt, bar.gravity,
+                       static_settings(2));
+  run(reference);
+  ASSERT_EQ(adaptive.flat().mesh.tets.rows(), leaves.mesh.tets.rows());
+  ASSERT_EQ(adaptive.constraints().num_hanging(), 0);
+  const MatrixX3d probe = (MatrixX3d(1, 3) << 1.0, 0.125, 0.125).finished();
+  const MatrixX3d u = adaptive.displacements(adaptive.locate(probe, "probes"));
+  // Same vertices in the same order (flattening is deterministic): compare positions directly.
+  EXPECT_LT((adaptive.simulation().positions() - reference.positions()).lpNorm<Eigen::Infinity>(),
+            1e-9 * std::abs(u(0, 2)));
+  EXPECT_LT(u(0, 2), -1e-3);
+}
+
+TEST(AdaptiveSimulation, UniformCoarseLevelEqualsCoreOnTheCoarseMesh) {
+  // Loads spread on the finest level of a 2-level tree and carried to the roots equal core's
+  // spreading on the coarse mesh for a load on whole coarse faces (a uniform traction's lumped
+  // loads are consistent, and consistent loads nest).
+  const Bar bar;
+  AdaptiveSimulation adaptive(bar.coarse, hierarchy(2, HierarchyMode::uniform, 0), rubber(),
+                              bar.fixed, bar.loads, std::nullopt, bar.gravity, static_settings(2));
+  run(adaptive);
+  Simulation reference(bar.coarse, rubber(), bar.fixed, bar.loads, std::nullopt, bar.gravity,
+                       static_settings(2));
+  run(reference);
+  ASSERT_EQ(adaptive.flat().mesh.tets.rows(), bar.coarse.tets.rows());
+  const double scale = (reference.positions() - reference.model().rest_positions()).norm();
+  EXPECT_LT((adaptive.simulation().positions() - reference.positions()).norm(), 1e-9 * scale);
+}
+
+TEST(FinestLevelLoads, TotalForceIsKeptOnEveryCut) {
+  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.5), {2, 2, 1});
+  TetTree tree(coarse, 3);
+  // A patch inside one coarse face (no coarse vertex in it).
+  const std::vector<RegionLoad> loads = {
+      box_load(Vector3d(0.1, 0.1, 0.5), Vector3d(0.3, 0.2, 0.5), Vector3d(1.0, -2.0, -30.0))};
+  const std::vector<PointLoad> points =
+      finest_level_loads(tree, loads, region_tolerance(coarse.vertices));
+  ASSERT_FALSE(points.empty());
+  for (int level = 0; level <= 3; ++level) {
+    ActiveCut cut = ActiveCut::uniform(tree, level);
+    const FlatTreeMesh flat = flatten_nodes(tree, cut.nodes());
+    const VectorXd f = map_point_loads(cut, flat, points);
+    Vector3d total = Vector3d::Zero();
+    for (Index v = 0; v < f.size() / 3; ++v)
+      total += f.segment<3>(3 * v);
+    EXPECT_LT((total - loads[0].total_force).norm(), 1e-12 * 30.0) << "level " << level;
+    // Only vertices of the loaded face's plane carry load, and some coarse vertex does at level 0.
+    for (Index v = 0; v < f.size() / 3; ++v)
+      if (f.segment<3>(3 * v).norm() > 0.0) {
+        EXPECT_NEAR(flat.mesh.vertices(v, 2), 0.5, 1e-12);
+      }
+  }
+  EXPECT_THROW(finest_level_loads(
+                   tree, {box_load(Vector3d(5, 5, 5), Vector3d(6, 6, 6), Vector3d::UnitX())}, 1e-9),
+               InputError);
+}
+
+TEST(AdaptiveSimulation, SmallFixedPatchIsResolvedExactly) {
+  // A prescribed patch on the top face that contains no coarse vertex: the driver refines until
+  // every finest vertex in the patch is interpolated from selected vertices only, so all of them
+  // move exactly as prescribed.
+  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.5), {2, 2, 1});
+  std::vector<DirichletSpec> groups = {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
+  DirichletSpec push;
+  push.name = "prescribed.0";
+  push.region = BoxRegion{Vector3d(0.125, 0.125, 0.5), Vector3d(0.375, 0.375, 0.5)};
+  push.kind = DirichletKind::displacement;
+  push.displacement = Vector3d(0, 0, -0.01);
+  groups.push_back(push);
+  AdaptiveSimulation sim(coarse, hierarchy(3, HierarchyMode::uniform, 0), rubber(), groups, {},
+                         std::nullopt, Vector3d::Zero(), static_settings(1));
+  EXPECT_GT(sim.cut().size(), coarse.tets.rows());            // refined for exactness
+  EXPECT_LT(sim.cut().size(), 512 * coarse.tets.rows() / 4);  // … only near the patch
+  run(sim);
+  const FlatTreeMesh& flat = sim.flat();
+  const VectorXd& x = sim.simulation().positions();
+  int in_patch = 0;
+  for (Index v = 0; v < flat.mesh.vertices.rows(); ++v) {
+    const Vector3d X = flat.mesh.vertices.row(v).transpose();
+    if (X.z() == 0.5 && X.x() >= 0.125 && X.x() <= 0.375 && X.y() >= 0.125 && X.y() <= 0.375) {
+      ++in_patch;
+      EXPECT_LT((x.segment<3>(3 * v) - X - push.displacement).norm(), 1e-12);
+    }
+  }
+  EXPECT_GE(in_patch, 9);
+  // Finest-level material points inside the patch follow it too (probes between vertices).
+  MatrixX3d probes(2, 3);
+  probes << 0.2, 0.3, 0.5, 0.37, 0.13, 0.5;
+  const MatrixX3d u = sim.displacements(sim.locate(probes, "probes"));
+  for (Index i = 0; i < 2; ++i)
+    EXPECT_LT((u.row(i).transpose() - push.displacement).norm(), 1e-12);
+}
+
+/// A slab fixed at the bottom, pressed by a small patch on top.
+struct PressedSlab {
+  TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.25), {4, 4, 1});
+  std::vector<DirichletSpec> fixed = {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
+  std::vector<RegionLoad> loads = {
+      box_load(Vector3d(0.4, 0.4, 0.25), Vector3d(0.6, 0.6, 0.25), Vector3d(0, 0, -500.0))};
+  MatrixX3d probe = (MatrixX3d(1, 3) << 0.5, 0.5, 0.25).finished();
+
+  double probe_uz(const HierarchySettings& settings, Index* tets) const {
+    AdaptiveSimulation sim(coarse, settings, rubber(), fixed, loads, std::nullopt, Vector3d::Zero(),
+                           static_settings(2));
+    run(sim);
+    if (tets) *tets = sim.cut().size();
+    return sim.displacements(sim.locate(probe, "probes"))(0, 2);
+  }
+};
+
+TEST(AdaptiveSimulation, LocalisedLoadRefinesNearItAndApproachesFullResolution) {
+  const PressedSlab slab;
+  Index full_tets = 0, coarse_tets = 0, adaptive_tets = 0;
+  const double full = slab.probe_uz(hierarchy(2, HierarchyMode::full), &full_tets);
+  const double coarse = slab.probe_uz(hierarchy(2, HierarchyMode::uniform, 0), &coarse_tets);
+  const double adaptive = slab.probe_uz(hierarchy(2, HierarchyMode::adaptive, 0), &adaptive_tets);
+  ASSERT_LT(full, 0.0);
+  const double coarse_error = std::abs(coarse - full) / std::abs(full);
+  const double adaptive_error = std::abs(adaptive - full) / std::abs(full);
+  EXPECT_GT(coarse_error, 0.05);  // the coarse mesh is far off: the scene needs refinement
+  EXPECT_LT(adaptive_error, 0.25 * coarse_error);
+  EXPECT_LT(adaptive_tets, full_tets / 2);
+  EXPECT_GT(adaptive_tets, coarse_tets);
+}
+
+TEST(AdaptiveSimulation, RefinementKeepsTheEnergyAndTheCutFollowsTheLoad) {
+  const PressedSlab slab;
+  SolverSettings settings;
+  settings.integrator = Integrator::implicit_euler;
+  settings.dt = 2e-3;
+  settings.duration = 0.04;
+  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
+  h.adapt_every = 2;
+  h.criteria.min_steps_between_changes = 2;
+  AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
+                         Vector3d::Zero(), settings);
+  run(sim);
+  ASSERT_FALSE(sim.changes().empty());
+  for (const CutChangeRecord& change : sim.changes())
+    if (change.coarsened == 0) {
+      // New vertices lie on the old linear field: same positions and velocities, same energy.
+      EXPECT_NEAR(change.energy_after, change.energy_before,
+                  1e-9 * std::max(1e-12, change.energy_before));
+    }
+  // Every refined tet lies near the patch (within one coarse cell of it).
+  const VectorXi levels = sim.cell_levels();
+  const FlatTreeMesh& flat = sim.flat();
+  for (Index t = 0; t < levels.size(); ++t)
+    if (levels[t] > 0) {
+      Vector3d centroid = Vector3d::Zero();
+      for (int k = 0; k < 4; ++k)
+        centroid += flat.mesh.vertices.row(flat.mesh.tets(t, k)).transpose() / 4.0;
+      EXPECT_LT((centroid.head<2>() - Eigen::Vector2d(0.5, 0.5)).lpNorm<Eigen::Infinity>(), 0.4);
+    }
+  EXPECT_EQ(sim.history().size(), static_cast<size_t>(sim.step_count() + 1));
+}
+
+TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
+  const PressedSlab slab;
+  SolverSettings settings;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.duration = 0.0;
+  // dt between the coarse and the level-1 stable step: refinement must be refused.
+  settings.dt = 1.0;
+  settings.duration = 1.0;
+  const double coarse_dt =
+      Simulation(slab.coarse, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings)
+          .stable_dt_estimate();
+  settings.dt = 0.9 * coarse_dt;
+  settings.duration = 20 * settings.dt;
+  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
+  h.adapt_every = 1;
+  h.criteria.min_steps_between_changes = 0;
+  AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
+                         Vector3d::Zero(), settings);
+  run(sim);
+  EXPECT_EQ(sim.cut().finest_level(), 0);
+  // With a small enough step the same scene refines.
+  settings.dt = 0.2 * coarse_dt;
+  settings.duration = 20 * settings.dt;
+  AdaptiveSimulation fine(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
+                          Vector3d::Zero(), settings);
+  run(fine);
+  EXPECT_GT(fine.cut().finest_level(), 0);
+}
+
+TEST(AdaptiveSimulation, RejectsBadSettings) {
+  const Bar bar;
+  HierarchySettings h = hierarchy(2, HierarchyMode::uniform, 3);
+  EXPECT_THROW(AdaptiveSimulation(bar.coarse, h, rubber(), bar.fixed, bar.loads, std::nullopt,
+                                  bar.gravity, static_settings(1)),
+               InputError);
+  h = hierarchy(9, HierarchyMode::full);
+  EXPECT_THROW(validate_hierarchy_settings(h, "hierarchy"), InputError);
+  h = hierarchy(2, HierarchyMode::adaptive);
+  h.indicator = "magic";
+  EXPECT_THROW(validate_hierarchy_settings(h, "hierarchy"), InputError);
+}
+
+}  // namespace
+}  // namespace strata
