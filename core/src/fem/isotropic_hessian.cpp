@@ -107,30 +107,43 @@ Matrix9d frame_hessian_matrix(const SingularFrameHessian& h, bool project_psd) {
   const Matrix3d& U = h.svd.U;
   const Matrix3d& V = h.svd.V;
   const Matrix3d A = project_psd ? project_symmetric_3x3(h.sigma_hessian) : h.sigma_hessian;
-  // Column i of D is vec(u_i v_iᵀ), vec(M)[3c + r] = M(r, c): the stretch directions.
-  Eigen::Matrix<double, 9, 3> D;
+  // H = Σ_k left_k right_kᵀ over nine rank-one terms, in plain arrays (Eigen would route these
+  // small products through its GEMM kernel). Terms 0–2: right_i = vec(u_i v_iᵀ) (the stretch
+  // directions, vec(M)[3c + r] = M(r, c)), left_i = Σ_j A_ij right_j. Terms 3–8, per pair (i, j):
+  // vec(u_i v_jᵀ ± u_j v_iᵀ) (flip +, twist −), weighted by half the eigenvalue (the √2 norm).
+  double left[9][9], right[9][9];
   for (int i = 0; i < 3; ++i)
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r)
-        D(3 * c + r, i) = U(r, i) * V(c, i);
-  const Eigen::Matrix<double, 9, 3> DA = D * A;
-  Matrix9d H;
-  H.noalias() = DA * D.transpose();
-  // Pair modes: vec(u_i v_jᵀ ± u_j v_iᵀ)/√2 with the flip (+) and twist (−) eigenvalues.
+        right[i][3 * c + r] = U(r, i) * V(c, i);
+  for (int i = 0; i < 3; ++i)
+    for (int e = 0; e < 9; ++e)
+      left[i][e] = A(i, 0) * right[0][e] + A(i, 1) * right[1][e] + A(i, 2) * right[2][e];
   for (int p = 0; p < 3; ++p) {
     const int i = kPairs[p][0], j = kPairs[p][1];
-    const double flip = project_psd ? std::max(h.flip[p], 0.0) : h.flip[p];
-    const double twist = project_psd ? std::max(h.twist[p], 0.0) : h.twist[p];
-    Vector9d plus, minus;
+    const double flip = 0.5 * (project_psd ? std::max(h.flip[p], 0.0) : h.flip[p]);
+    const double twist = 0.5 * (project_psd ? std::max(h.twist[p], 0.0) : h.twist[p]);
+    double* plus = right[3 + 2 * p];
+    double* minus = right[4 + 2 * p];
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r) {
         const double ij = U(r, i) * V(c, j), ji = U(r, j) * V(c, i);
         plus[3 * c + r] = ij + ji;
         minus[3 * c + r] = ij - ji;
       }
-    H.noalias() += (0.5 * flip) * plus * plus.transpose();
-    H.noalias() += (0.5 * twist) * minus * minus.transpose();
+    for (int e = 0; e < 9; ++e) {
+      left[3 + 2 * p][e] = flip * plus[e];
+      left[4 + 2 * p][e] = twist * minus[e];
+    }
   }
+  Matrix9d H;
+  for (int col = 0; col < 9; ++col)
+    for (int row = 0; row < 9; ++row) {
+      double sum = 0.0;
+      for (int k = 0; k < 9; ++k)
+        sum += left[k][row] * right[k][col];
+      H(row, col) = sum;
+    }
   return H;
 }
 
