@@ -56,30 +56,35 @@ VectorXd ForceIndicator::localised_loads(ConstRef<VectorXd> external_forces,
   return loads;
 }
 
-double ForceIndicator::body_surface_area(const CutState& state) {
-  const TetTree& tree = state.tree;
+double ForceIndicator::body_surface_area(const TetTree& tree) {
   MatrixX4i roots(tree.num_roots(), 4);
   for (Index r = 0; r < tree.num_roots(); ++r) {
     const std::array<int, 4> v = tree.tet_vertices(static_cast<NodeId>(r));
     roots.row(r) << v[0], v[1], v[2], v[3];
   }
-  // Coarse vertices are corners of every valid cut, so each has a flat vertex.
-  const auto position = [&](int coarse_vertex) -> Vector3d {
-    const int v = state.flat.mesh_vertices[coarse_vertex];
-    STRATA_VERIFY(v >= 0, "ForceIndicator: a coarse vertex is missing from the flattened cut");
-    return state.positions.segment<3>(3 * v);
-  };
   const MatrixX3i boundary = boundary_faces(roots);
   double area = 0.0;
   for (Index f = 0; f < boundary.rows(); ++f)
     area +=
-        triangle_area(position(boundary(f, 0)), position(boundary(f, 1)), position(boundary(f, 2)));
+        triangle_area(tree.vertex_position(boundary(f, 0)), tree.vertex_position(boundary(f, 1)),
+                      tree.vertex_position(boundary(f, 2)));
   return area;
+}
+
+double ForceIndicator::cached_surface_area(const TetTree& tree) const {
+  double checksum = 0.0;
+  for (Index v = 0; v < tree.num_coarse_vertices(); ++v)
+    checksum += static_cast<double>(v % 7 + 1) * tree.vertex_position(static_cast<int>(v)).sum();
+  const std::lock_guard<std::mutex> lock(m_cache_mutex);
+  if (m_cache.tree != &tree || m_cache.num_roots != tree.num_roots() ||
+      m_cache.checksum != checksum)
+    m_cache = {&tree, tree.num_roots(), checksum, body_surface_area(tree)};
+  return m_cache.area;
 }
 
 namespace {
 
-ForceParts force_parts(const CutState& state, double stress_floor) {
+ForceParts force_parts(const CutState& state, double stress_floor, double surface) {
   const Index num_vertices = state.flat.mesh.vertices.rows();
   STRATA_VERIFY(state.positions.size() == 3 * num_vertices &&
                     state.external_forces.size() == 3 * num_vertices &&
@@ -93,7 +98,6 @@ ForceParts force_parts(const CutState& state, double stress_floor) {
   for (Index v = 0; v < num_vertices; ++v)
     if (parts.areas[v] > 0.0)
       load_sum += parts.loads.segment<3>(3 * v).squaredNorm() / parts.areas[v];
-  const double surface = ForceIndicator::body_surface_area(state);
   ForceReference& ref = parts.reference;
   ref.stress_rms = volume_rms_stress(state);
   ref.load_rms = surface > 0.0 ? std::sqrt(load_sum / surface) : 0.0;
@@ -105,11 +109,11 @@ ForceParts force_parts(const CutState& state, double stress_floor) {
 }  // namespace
 
 ForceReference ForceIndicator::reference(const CutState& state) const {
-  return force_parts(state, m_stress_floor).reference;
+  return force_parts(state, m_stress_floor, cached_surface_area(state.tree)).reference;
 }
 
 void ForceIndicator::evaluate(const CutState& state, VectorXd& eta) const {
-  const ForceParts parts = force_parts(state, m_stress_floor);
+  const ForceParts parts = force_parts(state, m_stress_floor, cached_surface_area(state.tree));
   const MatrixX4i& tets = state.flat.mesh.tets;
   eta.resize(tets.rows());
   for (Index t = 0; t < tets.rows(); ++t) {

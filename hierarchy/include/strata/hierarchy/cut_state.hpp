@@ -13,7 +13,11 @@
 namespace strata {
 
 /// A snapshot of the simulation on the flattened active cut `flat` of `tree` (#V vertices,
-/// #T tets). All references must outlive the snapshot.
+/// #T tets). The referenced objects and the viewed vectors must outlive the snapshot.
+///
+/// The vectors are `Eigen::Ref<const VectorXd>` views held by value rather than `ConstRef`
+/// (`const Ref&`): a reference member would bind to a temporary Ref made from the caller's
+/// VectorXd, which dies at the end of the statement unless the CutState is a braced local.
 struct CutState {
   const TetTree& tree;
   /// The flattened active cut: flat.mesh (rest, #V × 3, #T × 4), flat.tet_nodes (#T).

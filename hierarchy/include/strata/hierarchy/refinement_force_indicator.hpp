@@ -24,8 +24,9 @@
 /// - s_ref = max(S_σ, S_load, floor · E), the body's stress scale [Pa]:
 ///   S_σ = √(Σ_t V_t ‖σ_t‖_F² / Σ V_t), the volume-RMS stress (refinement_indicator.hpp);
 ///   S_load = √(Σ_v |g_v|² / c_v / A_∂), the RMS traction the loads would exert if spread over the
-///   whole body surface A_∂ (deformed boundary area of the coarse mesh) — the scale that matters
-///   before stresses have built up; floor · E keeps η finite in an unloaded, unstressed body
+///   whole body surface A_∂ (rest boundary area of the coarse mesh, cached per tree) — the scale
+///   that matters before stresses have built up; floor · E keeps η finite in an unloaded,
+///   unstressed body
 ///   (`stress_floor` relative to Young's modulus, default 1e-6: strains below a microstrain never
 ///   drive refinement).
 ///
@@ -37,6 +38,8 @@
 /// Rejected alternatives: the ratio of a vertex force to its share of gravity depends on the size
 /// and on g (undefined without gravity); raw nodal forces scale with the element size; a residual
 /// f_int + f_ext vanishes at equilibrium, exactly where a static load is concentrated.
+#include <mutex>
+
 #include "strata/hierarchy/refinement_indicator.hpp"
 
 namespace strata {
@@ -68,12 +71,25 @@ class ForceIndicator final : public RefinementIndicator {
   static VectorXd localised_loads(ConstRef<VectorXd> external_forces,
                                   ConstRef<VectorXd> vertex_mass);
 
-  /// Deformed surface area of the body [m²]: the boundary of the tree's roots (the coarse mesh),
-  /// at the positions of the coarse vertices in `state.positions`.
-  static double body_surface_area(const CutState& state);
+  /// Rest surface area of the body [m²]: the boundary of the tree's roots (the coarse mesh).
+  /// O(#roots log #roots).
+  static double body_surface_area(const TetTree& tree);
 
  private:
+  /// A_∂ of `tree`, computed once per coarse mesh (keyed by the tree's address, sizes and a
+  /// checksum of the coarse vertices) and reused, since the coarse mesh never changes.
+  double cached_surface_area(const TetTree& tree) const;
+
+  struct SurfaceCache {
+    const TetTree* tree = nullptr;
+    Index num_roots = 0;
+    double checksum = 0.0;
+    double area = 0.0;
+  };
+
   double m_stress_floor;
+  mutable std::mutex m_cache_mutex;
+  mutable SurfaceCache m_cache;
 };
 
 }  // namespace strata
