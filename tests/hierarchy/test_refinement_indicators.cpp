@@ -101,6 +101,23 @@ TEST(ForceIndicator, ScaleFreeInLengthStiffnessAndLoad) {
   EXPECT_LE((jump_eta[0] - jump_eta[1]).cwiseAbs().maxCoeff(), 1e-8 * jump_eta[0].maxCoeff());
 }
 
+// One indicator evaluated on different trees (its cached surface area must follow the tree).
+TEST(ForceIndicator, SurfaceAreaCacheFollowsTheTree) {
+  const ForceIndicator shared;
+  const std::vector<PointLoad> loads{{Vector3d(0.5, 0.5, 0.25), Vector3d(0, 0, -1.0)}};
+  for (const double scale : {1.0, 0.5, 1.0}) {
+    TetTree tree(slab(scale), 1);
+    const ActiveCut cut(tree);
+    std::vector<PointLoad> scaled = loads;
+    scaled[0].point *= scale;
+    const test::CutSnapshot s = make_snapshot(cut, test_material(), test::no_motion, scaled);
+    // Surface of the box: 2 (1·1 + 1·0.25 + 1·0.25) = 3 m² times scale².
+    EXPECT_NEAR(ForceIndicator::body_surface_area(tree), 3.0 * scale * scale, 1e-12);
+    EXPECT_DOUBLE_EQ(shared.reference(s.state()).load_rms,
+                     ForceIndicator().reference(s.state()).load_rms);
+  }
+}
+
 // A small loaded patch inside the top face of one coarse tet: no coarse vertex in it, but the
 // load reaches that tet's corners and the indicator fires there, at rest (no stress yet).
 TEST(ForceIndicator, PatchInsideACoarseTetIsSeenAtRest) {
