@@ -1,0 +1,19 @@
+#pragma once
+/// \file vtp.hpp
+/// VTK XML PolyData (.vtp): triangle surfaces with point and cell fields for ParaView, e.g. the
+/// deformed fine surface of a run. Same conventions as vtu.hpp (ASCII, round-trip doubles, atomic).
+/// Format: https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html
+#include <filesystem>
+
+#include "strata/core/io/vtu.hpp"
+
+namespace strata {
+
+/// Writes a triangle surface as an ASCII .vtp, atomically: `positions` (#V × 3), `triangles`
+/// (#F × 3, written as Polys) and the named `fields` (point data #V × k, cell data #F × k;
+/// Float64 / Int32). Throws InputError naming the path and field when a field's row count does not
+/// match #V or #F, or a triangle index is out of range.
+void write_vtp(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
+               ConstRef<MatrixX3i> triangles, const VtuFields& fields = {});
+
+}  // namespace strata

@@ -1,0 +1,27 @@
+#pragma once
+/// \file level_set_impl.hpp
+/// The OpenVDB grid behind `LevelSet` (private to the meshing library: only level_set*.cpp include
+/// this header).
+#include <openvdb/openvdb.h>
+
+#include "strata/meshing/level_set.hpp"
+
+namespace strata {
+
+struct LevelSet::Impl {
+  openvdb::FloatGrid::Ptr grid;  ///< never null; GRID_LEVEL_SET with a uniform linear transform
+};
+
+namespace detail {
+
+/// openvdb::initialize() once per process (thread-safe).
+void ensure_openvdb_initialized();
+
+/// A LevelSet owning `grid` (marks it as a level set).
+LevelSet wrap_level_set(openvdb::FloatGrid::Ptr grid);
+
+/// Checks a voxel size and half width; InputError naming `what` otherwise.
+void check_level_set_options(const LevelSetOptions& options, const std::string& what);
+
+}  // namespace detail
+}  // namespace strata

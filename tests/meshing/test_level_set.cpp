@@ -1,0 +1,247 @@
+// Level sets: analytic distances of primitives, gradients, CSG, mesh-to-volume on closed and
+// open surfaces, .vdb round trip and bad files.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/io_test_utils.hpp"
+#include "meshing_test_utils.hpp"
+#include "strata/core/common/error.hpp"
+#include "strata/meshing/level_set.hpp"
+
+namespace strata {
+namespace {
+
+using testing::box_surface;
+using testing::random_direction;
+using testing::ScratchDir;
+
+const Vector3d kCenter(0.1, 0.2, -0.05);
+constexpr double kRadius = 0.5;
+constexpr double kVoxel = 0.02;
+
+/// Random points whose distance to the sphere is below `band` (all eight interpolation corners
+/// then hold narrow-band values).
+std::vector<Vector3d> points_near_sphere(int count, double band, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> offset(-band, band);
+  std::vector<Vector3d> points;
+  for (int i = 0; i < count; ++i)
+    points.push_back(kCenter + (kRadius + offset(rng)) * random_direction(rng));
+  return points;
+}
+
+TEST(LevelSet, SphereDistanceMatchesAnalyticWithinTheBand) {
+  const LevelSetOptions options{kVoxel, 4.0};
+  const LevelSet sphere = level_set_sphere(kCenter, kRadius, options);
+  EXPECT_DOUBLE_EQ(sphere.voxel_size(), kVoxel);
+  EXPECT_NEAR(sphere.background(), 4.0 * kVoxel, 1e-7);
+  // Corners lie within √3·h of the point: keep |d| ≤ background − √3·h.
+  const double band = (4.0 - std::sqrt(3.0)) * kVoxel;
+  // Trilinear interpolation error ≤ (h²/8)·Σ|∂²φ/∂x_i²| ≤ 3h²/(8ρ), ρ the smallest radius of
+  // curvature of the distance's level sets near the point (≥ r − band).
+  const double bound = 3.0 * kVoxel * kVoxel / (8.0 * (kRadius - band - std::sqrt(3.0) * kVoxel));
+  double worst = 0.0;
+  for (const Vector3d& p : points_near_sphere(500, band, 1)) {
+    const double exact = (p - kCenter).norm() - kRadius;
+    worst = std::max(worst, std::abs(sphere.signed_distance(p) - exact));
+  }
+  EXPECT_LT(worst, bound);
+  EXPECT_LT(worst, 0.05 * kVoxel);
+  // Outside the band: clamped to ±background.
+  EXPECT_NEAR(sphere.signed_distance(kCenter), -sphere.background(), 1e-7);
+  EXPECT_NEAR(sphere.signed_distance(kCenter + Vector3d(3, 0, 0)), sphere.background(), 1e-7);
+}
+
+TEST(LevelSet, GradientIsTheUnitNormalAndMatchesFiniteDifferences) {
+  const LevelSet sphere = level_set_sphere(kCenter, kRadius, {kVoxel, 4.0});
+  const double band = (4.0 - std::sqrt(3.0)) * kVoxel;
+  double worst_normal = 0.0;
+  for (const Vector3d& p : points_near_sphere(500, band, 2)) {
+    const Vector3d normal = (p - kCenter).normalized();
+    Vector3d gradient;
+    const double value = sphere.signed_distance_and_gradient(p, gradient);
+    EXPECT_DOUBLE_EQ(value, sphere.signed_distance(p));
+    EXPECT_EQ(gradient, sphere.gradient(p));
+    worst_normal = std::max(worst_normal, (gradient - normal).norm());
+    // The gradient is the interpolant's own: central differences inside one voxel agree.
+    const double step = 1e-6 * kVoxel;
+    for (int a = 0; a < 3; ++a) {
+      const Vector3d e = step * Vector3d::Unit(a);
+      const double fd =
+          (sphere.signed_distance(p + e) - sphere.signed_distance(p - e)) / (2 * step);
+      const bool near_face = std::abs(std::remainder(p(a) / kVoxel, 1.0)) < 1e-4;
+      if (!near_face) {
+        EXPECT_NEAR(gradient(a), fd, 1e-4);
+      }
+    }
+  }
+  // First-order accuracy of the interpolant's gradient: error ≲ √3·h/ρ.
+  EXPECT_LT(worst_normal, std::sqrt(3.0) * kVoxel / (kRadius - 2 * kVoxel * 2.3));
+}
+
+TEST(LevelSet, CsgOfTwoSpheres) {
+  const LevelSetOptions options{kVoxel, 3.0};
+  const Vector3d ca(0, 0, 0), cb(0.6, 0, 0);
+  const LevelSet a = level_set_sphere(ca, 0.5, options);
+  const LevelSet b = level_set_sphere(cb, 0.5, options);
+  const LevelSet united = csg_union(a, b);
+  const LevelSet common = csg_intersection(a, b);
+  const LevelSet a_minus_b = csg_difference(a, b);
+  const Vector3d in_both(0.3, 0, 0), in_a(-0.3, 0, 0), in_b(0.9, 0, 0), in_neither(0.3, 0.45, 0);
+  EXPECT_LT(united.signed_distance(in_both), 0);
+  EXPECT_LT(united.signed_distance(in_a), 0);
+  EXPECT_LT(united.signed_distance(in_b), 0);
+  EXPECT_GT(united.signed_distance(in_neither), 0);
+  EXPECT_LT(common.signed_distance(in_both), 0);
+  EXPECT_GT(common.signed_distance(in_a), 0);
+  EXPECT_GT(common.signed_distance(in_b), 0);
+  EXPECT_LT(a_minus_b.signed_distance(in_a), 0);
+  EXPECT_GT(a_minus_b.signed_distance(in_both), 0);
+  EXPECT_GT(a_minus_b.signed_distance(in_b), 0);
+  // At voxel centres (no interpolation) the values are min / max of the operands' voxel values
+  // wherever both lie in their bands.
+  int checked = 0;
+  for (int i = -30; i <= 60; ++i) {
+    for (int j = -30; j <= 30; ++j) {
+      const Vector3d p = kVoxel * Vector3d(i, j, 3);
+      const double da = (p - ca).norm() - 0.5, db = (p - cb).norm() - 0.5;
+      if (std::abs(da) > 2 * kVoxel || std::abs(db) > 2 * kVoxel) continue;
+      ++checked;
+      const double fa = a.signed_distance(p), fb = b.signed_distance(p);
+      EXPECT_NEAR(fa, da, 1e-3 * kVoxel);
+      EXPECT_EQ(united.signed_distance(p), std::min(fa, fb));
+      EXPECT_EQ(common.signed_distance(p), std::max(fa, fb));
+      EXPECT_EQ(a_minus_b.signed_distance(p), std::max(fa, -fb));
+    }
+  }
+  EXPECT_GT(checked, 20);
+  // Inputs are unchanged.
+  EXPECT_LT(b.signed_distance(in_b), 0);
+  EXPECT_THROW(csg_union(a, level_set_sphere(cb, 0.5, {0.03, 3.0})), InputError);
+}
+
+TEST(LevelSet, PrimitivesMatchTheirDistanceFunctions) {
+  const LevelSetOptions options{0.01, 3.0};
+  const LevelSet box = level_set_box(Vector3d(0, 0, 0), Vector3d(1, 0.5, 0.4), options);
+  // Near face centres the box distance is linear: interpolation is exact up to float rounding.
+  EXPECT_NEAR(box.signed_distance(Vector3d(0.5, 0.25, 0.413)), 0.013, 1e-6);
+  EXPECT_NEAR(box.signed_distance(Vector3d(1.004, 0.25, 0.2)), 0.004, 1e-6);
+  EXPECT_NEAR(box.signed_distance(Vector3d(0.5, 0.012, 0.2)), -0.012, 1e-6);
+  const LevelSet capsule = level_set_capsule(Vector3d(0, 0, 0), Vector3d(1, 0, 0), 0.2, options);
+  EXPECT_NEAR(capsule.signed_distance(Vector3d(0.5, 0.215, 0)), 0.015, 0.03 * 0.01);
+  EXPECT_NEAR(capsule.signed_distance(Vector3d(-0.21, 0, 0)), 0.01, 0.03 * 0.01);
+  EXPECT_NEAR(capsule.signed_distance(Vector3d(0.5, 0, 0)), -capsule.background(), 1e-7);
+  const LevelSet torus = level_set_torus(Vector3d(0, 0, 0), Vector3d(0, 0, 1), 0.5, 0.1, options);
+  EXPECT_NEAR(torus.signed_distance(Vector3d(0.61, 0, 0)), 0.01, 0.03 * 0.01);
+  EXPECT_NEAR(torus.signed_distance(Vector3d(0, 0.5, 0.085)), -0.015, 0.03 * 0.01);
+  EXPECT_NEAR(torus.signed_distance(Vector3d(0, 0, 0)), torus.background(), 1e-7);
+  EXPECT_NEAR(torus.signed_distance(Vector3d(0.5, 0, 0)), -torus.background(), 1e-7);
+}
+
+TEST(LevelSet, ToSurfaceEnclosesTheSphereVolume) {
+  const LevelSet sphere = level_set_sphere(kCenter, kRadius, {kVoxel, 3.0});
+  const SurfaceMesh surface = sphere.to_surface();
+  ASSERT_GT(surface.triangles.rows(), 100);
+  const double exact = 4.0 / 3.0 * std::numbers::pi * std::pow(kRadius, 3);
+  EXPECT_NEAR(enclosed_volume(surface), exact, 0.01 * exact);  // positive: oriented outward
+  for (Index v = 0; v < surface.vertices.rows(); ++v)
+    EXPECT_NEAR((surface.vertices.row(v).transpose() - kCenter).norm(), kRadius, 0.05 * kVoxel);
+}
+
+TEST(LevelSet, ClosedBoxSurfaceGivesExactDistancesNearFaces) {
+  const SurfaceLevelSet result =
+      surface_to_level_set(box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1)), {0.05, 3.0});
+  EXPECT_TRUE(result.topology.watertight()) << result.topology.summary();
+  EXPECT_EQ(result.topology.edges, 18);
+  const LevelSet& phi = result.level_set;
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.5, 0.5, 0.04)), -0.04, 1e-6);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.5, 0.43, 1.07)), 0.07, 1e-6);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.97, 0.5, 0.6)), -0.03, 1e-6);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.5, 0.5, 0.5)), -phi.background(), 1e-7);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(3, 0.5, 0.5)), phi.background(), 1e-7);
+  const auto [lo, hi] = phi.bounding_box();
+  EXPECT_NEAR(lo(0), -0.1, 0.051);
+  EXPECT_NEAR(hi(2), 1.1, 0.051);
+}
+
+TEST(LevelSet, OpenBoxIsReportedAndStillUsable) {
+  SurfaceMesh open = box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  open.triangles.conservativeResize(10, 3);  // drop the +z face
+  const SurfaceLevelSet result = surface_to_level_set(open, {0.05, 3.0});
+  EXPECT_FALSE(result.topology.watertight());
+  EXPECT_EQ(result.topology.boundary_edges, 4);
+  EXPECT_NE(result.topology.summary().find("not watertight: 4 boundary edges"), std::string::npos);
+  const LevelSet& phi = result.level_set;
+  EXPECT_LT(phi.signed_distance(Vector3d(0.5, 0.5, 0.5)), 0.0);
+  EXPECT_LT(phi.signed_distance(Vector3d(0.3, 0.6, 0.8)), 0.0);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.5, 0.5, 0.04)), -0.04, 1e-6);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.5, 0.5, -0.07)), 0.07, 1e-6);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(1.06, 0.5, 0.5)), 0.06, 1e-6);
+  EXPECT_NEAR(phi.signed_distance(Vector3d(0.96, 0.5, 0.5)), -0.04, 1e-6);
+  EXPECT_GT(phi.signed_distance(Vector3d(0.5, 0.5, 1.5)), 0.0);
+  EXPECT_GT(phi.signed_distance(Vector3d(3, 3, 3)), 0.0);
+  // Misoriented triangles (one face flipped) are reported, and the distances stay right.
+  SurfaceMesh flipped = box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  flipped.triangles.row(0) = flipped.triangles.row(0).reverse().eval();
+  const SurfaceLevelSet misoriented = surface_to_level_set(flipped, {0.05, 3.0});
+  EXPECT_EQ(misoriented.topology.misoriented_edges, 3);
+  EXPECT_LT(misoriented.level_set.signed_distance(Vector3d(0.5, 0.5, 0.5)), 0.0);
+  EXPECT_NEAR(misoriented.level_set.signed_distance(Vector3d(0.5, 0.5, 1.04)), 0.04, 1e-6);
+}
+
+TEST(LevelSet, VdbRoundTrip) {
+  ScratchDir dir("level_set_vdb");
+  const LevelSet torus =
+      level_set_torus(Vector3d(0.1, 0, 0), Vector3d(1, 1, 0), 0.4, 0.1, {0.02, 3.0});
+  torus.write_vdb(dir / "torus.vdb");
+  const LevelSet read = LevelSet::read_vdb(dir / "torus.vdb");
+  const LevelSet by_name = LevelSet::read_vdb(dir / "torus.vdb", "torus");
+  EXPECT_EQ(read.name(), "torus");
+  EXPECT_EQ(read.voxel_size(), torus.voxel_size());
+  EXPECT_EQ(read.background(), torus.background());
+  EXPECT_EQ(read.num_active_voxels(), torus.num_active_voxels());
+  std::mt19937 rng(4);
+  for (int i = 0; i < 200; ++i) {
+    const Vector3d p =
+        testing::random_point(rng, Vector3d(-0.6, -0.6, -0.6), Vector3d(0.7, 0.6, 0.6));
+    EXPECT_EQ(read.signed_distance(p), torus.signed_distance(p));
+    EXPECT_EQ(by_name.signed_distance(p), torus.signed_distance(p));
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "torus.vdb.tmp"));
+}
+
+TEST(LevelSet, MissingOrCorruptVdbNamesTheFile) {
+  ScratchDir dir("level_set_bad_vdb");
+  const auto expect_error = [](const std::filesystem::path& path, const std::string& grid) {
+    try {
+      LevelSet::read_vdb(path, grid);
+      ADD_FAILURE() << "no error for " << path;
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+    }
+  };
+  expect_error(dir / "missing.vdb", "");
+  testing::write_text(dir / "corrupt.vdb", "this is not a vdb file\n");
+  expect_error(dir / "corrupt.vdb", "");
+  level_set_sphere(kCenter, kRadius, {0.05, 3.0}).write_vdb(dir / "sphere.vdb");
+  expect_error(dir / "sphere.vdb", "no_such_grid");
+  // A truncated file.
+  const std::string content = testing::read_text(dir / "sphere.vdb");
+  testing::write_text(dir / "truncated.vdb", content.substr(0, content.size() / 2));
+  expect_error(dir / "truncated.vdb", "");
+}
+
+TEST(LevelSet, BadInputIsRejected) {
+  EXPECT_THROW(level_set_sphere(kCenter, -1.0, {0.05, 3.0}), InputError);
+  EXPECT_THROW(level_set_sphere(kCenter, 1.0, {0.0, 3.0}), InputError);
+  EXPECT_THROW(level_set_sphere(kCenter, 1.0, {0.05, 0.5}), InputError);
+  EXPECT_THROW(surface_to_level_set(SurfaceMesh{}, {0.05, 3.0}), InputError);
+  SurfaceMesh bad = box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  bad.triangles(3, 1) = 99;
+  EXPECT_THROW(surface_to_level_set(bad, {0.05, 3.0}), InputError);
+}
+
+}  // namespace
+}  // namespace strata
