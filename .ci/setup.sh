@@ -14,7 +14,7 @@ packages=(
   build-essential cmake g++ make
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libsuitesparse-dev
   libopenblas0-pthread libgtest-dev googletest libbenchmark-dev
-  libcgal-dev libopenvdb-dev libboost-iostreams-dev
+  libcgal-dev libcgal-demo libopenvdb-dev libboost-iostreams-dev
   python3-matplotlib python3-meshio clang-format
 )
 
