@@ -42,6 +42,10 @@ void RefinementController::set_refinement_veto(std::function<bool(NodeId)> may_r
   m_may_refine = std::move(may_refine);
 }
 
+void RefinementController::set_coarsening_veto(std::function<bool(NodeId)> may_coarsen) {
+  m_may_coarsen = std::move(may_coarsen);
+}
+
 long RefinementController::last_change_step(NodeId n) const {
   return n >= 0 && static_cast<std::size_t>(n) < m_last_change.size() ? m_last_change[n] : kNever;
 }
@@ -115,6 +119,7 @@ CutChanges RefinementController::decide(const CutState& state, const ActiveCut& 
     if (tree.node(n).child_slot != 0) continue;  // visit each sibling block once
     const NodeId parent = tree.parent(n);
     if (!settled(parent)) continue;
+    if (m_may_coarsen && !m_may_coarsen(parent)) continue;
     bool mergeable = true;
     Vector6d mean = Vector6d::Zero();
     for (int k = 0; k < 8 && mergeable; ++k) {

@@ -289,6 +289,26 @@ TEST(RefinementController, VetoIsHonoured) {
     }
 }
 
+TEST(RefinementController, CoarseningVetoPinsNodes) {
+  TetTree tree(test::slab(), 2);
+  RefinementController controller(fast_settings());
+  ActiveCut cut = ActiveCut::uniform(tree, 1);
+  // Keep the refinement of every root touching the plane x = 0 (a fixed region, say).
+  const auto touches_fixed = [&tree](NodeId n) {
+    return tree.tet_positions(n).row(0).minCoeff() < 1e-12;
+  };
+  controller.set_coarsening_veto([&](NodeId parent) { return !touches_fixed(parent); });
+  long step = 0;
+  run_to_steady(controller, cut, Scene{}, step, 5);
+  Index pinned = 0;
+  for (NodeId r = 0; r < tree.num_roots(); ++r) {
+    EXPECT_EQ(cut.is_active(r), !touches_fixed(r)) << r;
+    pinned += touches_fixed(r);
+  }
+  EXPECT_GT(pinned, 0);
+  EXPECT_EQ(cut.size(), tree.num_roots() + 7 * pinned);
+}
+
 TEST(RefinementController, MinimumStepsBetweenChangesOfANode) {
   TetTree tree(test::slab(), 1);
   RefinementSettings settings;

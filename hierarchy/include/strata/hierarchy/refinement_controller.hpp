@@ -12,9 +12,10 @@
 ///   η_k < coarsen_indicator_fraction · refine_threshold (none of them wants refinement, with a
 ///   margin), (b) the children's stresses agree:
 ///       max_k ‖σ_k − σ̄‖_F / (‖σ̄‖_F + stress_floor · E) < coarsen_tolerance,   σ̄ = mean of σ_k,
-///   (c) p has not changed for min_steps_between_changes steps, and (d) with `balance`, the cut
-///   stays 2:1 balanced (no active tet touching p's children, or planned to be refined next to
-///   them, is finer than p's children).
+///   (c) p has not changed for min_steps_between_changes steps, (d) the driver's veto
+///   `may_coarsen(p)` (if set) allows it, and (e) with `balance`, the cut stays 2:1 balanced (no
+///   active tet touching p's children, or planned to be refined next to them, is finer than p's
+///   children).
 /// - no node is both refined and coarsened in one decision: a refined node's parent is never
 ///   coarsened (its η exceeds the coarsening bound).
 ///
@@ -96,6 +97,10 @@ class RefinementController {
   /// The driver's veto: refinement of n is considered only if may_refine(n) (e.g. false below an
   /// explicit integrator's stable-step limit, or for nodes touching fixed regions). Empty: all.
   void set_refinement_veto(std::function<bool(NodeId)> may_refine);
+  /// The driver's veto on merging: the eight children of `parent` are merged only if
+  /// may_coarsen(parent) (e.g. false for nodes touching fixed or prescribed regions, to keep them
+  /// exact at the level they were refined to). Empty: all.
+  void set_coarsening_veto(std::function<bool(NodeId)> may_coarsen);
 
   /// The changes the criteria ask for on `cut` (whose flattening is `state.flat`), at
   /// `state.step`. Does not modify anything.
@@ -117,6 +122,7 @@ class RefinementController {
   RefinementSettings m_settings;
   std::unique_ptr<RefinementIndicator> m_indicator;
   std::function<bool(NodeId)> m_may_refine;
+  std::function<bool(NodeId)> m_may_coarsen;
   std::vector<long> m_last_change;  ///< per node id
   std::vector<int> m_change_count;  ///< per node id
 };
