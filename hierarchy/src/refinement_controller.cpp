@@ -64,6 +64,14 @@ void RefinementController::record_change(NodeId n, long step) {
   ++m_change_count[n];
 }
 
+void RefinementController::reset_children(const TetTree& tree, NodeId n) {
+  const NodeId first = tree.child(n, 0);
+  for (NodeId c = first; c < first + 8 && static_cast<std::size_t>(c) < m_last_change.size(); ++c) {
+    m_last_change[c] = kNever;
+    m_change_count[c] = 0;
+  }
+}
+
 CutChanges RefinementController::decide(const CutState& state, const ActiveCut& cut) const {
   const TetTree& tree = state.tree;
   const FlatTreeMesh& flat = state.flat;
@@ -165,13 +173,17 @@ CutChangeCounts RefinementController::apply(ActiveCut& cut, const CutChanges& ch
     if (!cut.is_active(n) || !tree.can_refine(n)) continue;
     cut.refine(n);
     record_change(n, step);
+    reset_children(tree, n);
     ++counts.refined;
   }
   if (m_settings.balance) {
     const std::vector<NodeId> before = cut.nodes();
     counts.balance_refined = balance_cut(cut);
     for (const NodeId n : before)
-      if (!cut.is_active(n)) record_change(n, step);
+      if (!cut.is_active(n)) {
+        record_change(n, step);
+        reset_children(tree, n);
+      }
   }
   return counts;
 }

@@ -336,6 +336,34 @@ TEST(RefinementController, MinimumStepsBetweenChangesOfANode) {
   EXPECT_EQ(round(controller, cut, bumped, 10).refine.size(), first.refine.size());
 }
 
+// The driver releases merged subtrees; the tree reuses their ids for the next refinement, and the
+// new children must not inherit the old ones' records.
+TEST(RefinementController, ReusedNodeIdsStartFresh) {
+  TetTree tree(test::slab(), 2);
+  RefinementSettings settings;
+  settings.min_steps_between_changes = 5;
+  RefinementController controller(settings);
+  ActiveCut cut(tree);
+  CutChanges refine_first;
+  refine_first.refine = {7};
+  controller.apply(cut, refine_first, 0);
+  const NodeId child = tree.child(7, 3);
+  CutChanges refine_child;
+  refine_child.refine = {child};
+  controller.apply(cut, refine_child, 0);
+  EXPECT_EQ(controller.last_change_step(child), 0);
+  cut.coarsen(child);
+  cut.coarsen(7);
+  tree.coarsen_subtree(7);  // ids of 7's children go back to the pool
+  CutChanges refine_other;
+  refine_other.refine = {8};
+  controller.apply(cut, refine_other, 1);
+  ASSERT_EQ(tree.child(8, 3), child);  // the released block is reused
+  EXPECT_EQ(controller.last_change_step(child), RefinementController::kNever);
+  EXPECT_EQ(controller.change_count(child), 0);
+  EXPECT_EQ(controller.last_change_step(8), 1);
+}
+
 TEST(RefinementController, LevelCap) {
   TetTree tree(test::slab(), 3);
   RefinementSettings settings = fast_settings();

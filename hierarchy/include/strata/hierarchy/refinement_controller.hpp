@@ -23,7 +23,9 @@
 /// coarsen_indicator_fraction · refine_threshold before siblings may merge, and the merge also
 /// needs agreeing stresses (coarsen_tolerance ≪ 1); plus a minimum number of driver steps between
 /// two changes of one node (refinement of n and coarsening back into n both count as changes of
-/// n). Per-node records are arrays indexed by node id, grown with the tree's pool.
+/// n). Per-node records are arrays indexed by node id, grown with the tree's pool; a node's
+/// record starts when its parent's refinement makes it active (so ids the tree released and
+/// reused carry no stale history).
 ///
 /// Lifecycle per adaptive step: the driver flattens the cut and fills a CutState → `decide` →
 /// transfer state / `apply` → rebuild constraints and flatten. `apply` coarsens without
@@ -118,6 +120,9 @@ class RefinementController {
 
  private:
   void record_change(NodeId n, long step);
+  /// A refinement starts fresh records for the children (their ids may have been released and
+  /// reused since they were last active).
+  void reset_children(const TetTree& tree, NodeId n);
 
   RefinementSettings m_settings;
   std::unique_ptr<RefinementIndicator> m_indicator;
