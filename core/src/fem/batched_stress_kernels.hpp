@@ -13,6 +13,30 @@ namespace strata::detail {
 inline constexpr int kLanes = 4;
 using Lanes = double[kLanes];
 
+/// F = Ds Dm⁻¹ of the kLanes tets `tets` (4 vertex indices each) at `positions` (3·#V).
+/// lane_Dm_inv[(3c + j) · kLanes + l] = Dm⁻¹(j, c) of lane l.
+[[gnu::always_inline]] inline void lane_deformation_gradient(const double* positions,
+                                                             const int* tets,
+                                                             const double* lane_Dm_inv,
+                                                             double (&F)[3][3][kLanes]) {
+  double x[4][3][kLanes];
+  for (int l = 0; l < kLanes; ++l)
+    for (int k = 0; k < 4; ++k)
+      for (int r = 0; r < 3; ++r)
+        x[k][r][l] = positions[3 * tets[4 * l + k] + r];
+  double Ds[3][3][kLanes];
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 3; ++j)
+      for (int l = 0; l < kLanes; ++l)
+        Ds[r][j][l] = x[j + 1][r][l] - x[0][r][l];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < kLanes; ++l)
+        F[r][c][l] = Ds[r][0][l] * lane_Dm_inv[(3 * c + 0) * kLanes + l] +
+                     Ds[r][1][l] * lane_Dm_inv[(3 * c + 1) * kLanes + l] +
+                     Ds[r][2][l] * lane_Dm_inv[(3 * c + 2) * kLanes + l];
+}
+
 /// StVK: E = ½(FᵀF − I), S = λ tr(E) I + 2μ E, P = F S, ψ = μ E:E + λ/2 tr(E)².
 struct StvkLanes {
   double mu, lambda;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "batched_stiffness_kernels.hpp"
 #include "batched_stress_kernels.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/fem/deformation_gradient.hpp"
@@ -108,24 +109,8 @@ template <bool kWithEnergy, typename LaneKernel>
 double lane_group_forces(const LaneKernel& kernel, const double* positions, const int* tets,
                          const double* lane_Dm_inv, const double* volume, double* forces) {
   using detail::kLanes;
-  double x[4][3][kLanes];
-  for (int l = 0; l < kLanes; ++l)
-    for (int k = 0; k < 4; ++k)
-      for (int r = 0; r < 3; ++r)
-        x[k][r][l] = positions[3 * tets[4 * l + k] + r];
-  double Ds[3][3][kLanes];
-  for (int r = 0; r < 3; ++r)
-    for (int j = 0; j < 3; ++j)
-      for (int l = 0; l < kLanes; ++l)
-        Ds[r][j][l] = x[j + 1][r][l] - x[0][r][l];
-  // lane_Dm_inv[(3c + j) · kLanes + l] = Dm⁻¹(j, c) of lane l.
   double F[3][3][kLanes];
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      for (int l = 0; l < kLanes; ++l)
-        F[r][c][l] = Ds[r][0][l] * lane_Dm_inv[(3 * c + 0) * kLanes + l] +
-                     Ds[r][1][l] * lane_Dm_inv[(3 * c + 1) * kLanes + l] +
-                     Ds[r][2][l] * lane_Dm_inv[(3 * c + 2) * kLanes + l];
+  detail::lane_deformation_gradient(positions, tets, lane_Dm_inv, F);
   double P[3][3][kLanes], psi[kLanes];
   kernel.template operator()<kWithEnergy>(F, P, psi);
   // H = −V P Dm⁻ᵀ: column j is the force on vertex j + 1.
@@ -356,8 +341,27 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
   double* values = K.valuePtr();
   const bool closed_form_stvk = m_material.model == MaterialModel::stvk && !project_psd;
   for_each_chunk_colored(m_partition, [&](int chunk) {
+    int i = m_partition.chunk_begin[chunk];
+    const int end = m_partition.chunk_begin[chunk + 1];
+    if (closed_form_stvk) {
+      using detail::kLanes;
+      const detail::StvkStiffnessLanes lanes(m_lame);
+      double lane_K[kLanes][12][12];
+      for (; i + kLanes <= end; i += kLanes) {
+        const double* lane_Dm_inv = &m_lane_Dm_inv[9 * kLanes * (i / kLanes)];
+        // The value array is far larger than the caches: fetch the next group's entries while
+        // this group's blocks are computed.
+        if (i + 2 * kLanes <= end)
+          detail::prefetch_block_entries(&m_block_offsets[48 * (i + kLanes)], values);
+        double F[3][3][kLanes];
+        detail::lane_deformation_gradient(x.data(), &m_sorted_tets[4 * i], lane_Dm_inv, F);
+        lanes(F, lane_Dm_inv, &m_sorted_volume[i], lane_K);
+        for (int l = 0; l < kLanes; ++l)
+          detail::scatter_element_stiffness(lane_K[l], &m_block_offsets[48 * (i + l)], values);
+      }
+    }
     Matrix3d blocks[4][4];
-    for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
+    for (; i < end; ++i) {
       const int* tet = &m_sorted_tets[4 * i];
       const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
       const Matrix3d F = edge_matrix_at(x.data(), tet) * Dm_inv;

@@ -1,0 +1,103 @@
+#pragma once
+// Internal to elastic_model.cpp: the StVK element stiffness of kLanes tets at once in
+// structure-of-arrays form (vectorised across tets, like batched_stress_kernels.hpp), and its
+// scatter into the values of the fixed sparsity pattern.
+#include "batched_stress_kernels.hpp"
+
+namespace strata::detail {
+
+/// StVK element stiffness of each lane l, 12 × 12 column-major: K[l][3b + c][3a + r] = K_ab(r, c),
+/// K_ab = V [(g_aᵀ S g_b) I + λ (F g_a)(F g_b)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_b)(F g_a)ᵀ],
+/// g_k = ∇N_k (g_k = row k − 1 of Dm⁻¹ for k ≥ 1, g_0 = −g_1 − g_2 − g_3), S the second Piola
+/// stress. `lane_Dm_inv` in the layout of lane_deformation_gradient.
+struct StvkStiffnessLanes {
+  double mu, lambda;
+  explicit StvkStiffnessLanes(const LameParameters& lame) : mu(lame.mu), lambda(lame.lambda) {}
+
+  /// Explicit 4-wide vectors: written as lane loops, GCC vectorised only part of this kernel.
+  using Vec = double __attribute__((vector_size(kLanes * sizeof(double))));
+
+  void operator()(const double (&lane_F)[3][3][kLanes], const double* lane_Dm_inv,
+                  const double* lane_volume, double (&K)[kLanes][12][12]) const {
+    const auto load = [](const double* p) {
+      Vec v;
+      __builtin_memcpy(&v, p, sizeof(Vec));
+      return v;
+    };
+    const Vec volume = load(lane_volume);
+    Vec F[3][3], g[4][3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        F[r][c] = load(lane_F[r][c]);
+    for (int k = 1; k < 4; ++k)
+      for (int d = 0; d < 3; ++d)
+        g[k][d] = load(lane_Dm_inv + (3 * d + k - 1) * kLanes);
+    for (int d = 0; d < 3; ++d)
+      g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
+
+    Vec E[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = a; b < 3; ++b) {
+        E[a][b] = 0.5 * (F[0][a] * F[0][b] + F[1][a] * F[1][b] + F[2][a] * F[2][b]);
+        if (a == b) E[a][b] -= 0.5;
+        E[b][a] = E[a][b];
+      }
+    const Vec lambda_trace = lambda * (E[0][0] + E[1][1] + E[2][2]);
+    Vec S[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        S[a][b] = 2.0 * mu * E[a][b] + (a == b ? lambda_trace : Vec{});
+    // Fg = F g_k, VFg = V F g_k, VSg = V S g_k, FFt = F Fᵀ.
+    Vec Fg[4][3], VFg[4][3], VSg[4][3], FFt[3][3];
+    for (int k = 0; k < 4; ++k)
+      for (int r = 0; r < 3; ++r) {
+        Fg[k][r] = F[r][0] * g[k][0] + F[r][1] * g[k][1] + F[r][2] * g[k][2];
+        VFg[k][r] = volume * Fg[k][r];
+        VSg[k][r] = volume * (S[r][0] * g[k][0] + S[r][1] * g[k][1] + S[r][2] * g[k][2]);
+      }
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) {
+        FFt[r][c] = F[r][0] * F[c][0] + F[r][1] * F[c][1] + F[r][2] * F[c][2];
+        FFt[c][r] = FFt[r][c];
+      }
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b <= a; ++b) {
+        const Vec geometric = g[a][0] * VSg[b][0] + g[a][1] * VSg[b][1] + g[a][2] * VSg[b][2];
+        const Vec gg = (mu * volume) * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            Vec value = lambda * VFg[a][r] * Fg[b][c] + mu * VFg[b][r] * Fg[a][c] + gg * FFt[r][c];
+            if (r == c) value += geometric;
+            for (int l = 0; l < kLanes; ++l) {
+              K[l][3 * b + c][3 * a + r] = value[l];
+              if (a != b) K[l][3 * a + r][3 * b + c] = value[l];
+            }
+          }
+      }
+  }
+};
+
+/// Prefetches the sparse values that scatter_element_stiffness will update for the kLanes tets
+/// whose offsets start at `offsets`.
+inline void prefetch_block_entries(const int* offsets, const double* values) {
+  for (int k = 0; k < 48 * kLanes; ++k)
+    __builtin_prefetch(values + offsets[k], 1, 3);
+}
+
+/// Adds one tet's element stiffness (12 × 12, column-major) to the sparse values. `offsets` (48
+/// per tet): for vertex pair (a, b) and column c, offsets[12a + 3b + c] is the position of
+/// K(3a, 3b + c), with rows 3a + 1 and 3a + 2 following it.
+inline void scatter_element_stiffness(const double (&K)[12][12], const int* offsets,
+                                      double* values) {
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      for (int c = 0; c < 3; ++c) {
+        double* entry = values + offsets[12 * a + 3 * b + c];
+        const double* column = &K[3 * b + c][3 * a];
+        entry[0] += column[0];
+        entry[1] += column[1];
+        entry[2] += column[2];
+      }
+}
+
+}  // namespace strata::detail
