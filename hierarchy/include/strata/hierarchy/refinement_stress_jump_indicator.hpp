@@ -12,10 +12,11 @@
 /// stress: dimensionless, 0 for any uniform stress field, large where the piecewise-constant
 /// stress is under-resolved (a smooth gradient g gives η ~ g h / s_ref, so it falls as h does).
 ///
-/// Neighbours: a face shared by two active tets (same three vertices) is matched directly; a face
-/// on a non-conforming interface (finer and coarser active tets) is matched by locating the point
-/// just outside its centroid in the tree (rest geometry), so each face samples the neighbour at
-/// its centre.
+/// Neighbours: a face shared by two active tets (same three vertices) is matched through the
+/// vertex-to-tet incidence; an unmatched face lying on a coarse-mesh boundary face is surface; any
+/// other face (a non-conforming interface between finer and coarser active tets) is matched by
+/// locating the point just outside its centroid in the tree (rest geometry), so each such face
+/// samples the neighbour at its centre. Cost O(#T + #roots + #interface faces · depth).
 #include "strata/hierarchy/refinement_indicator.hpp"
 
 namespace strata {
