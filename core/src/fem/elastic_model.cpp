@@ -139,6 +139,21 @@ double lane_group_forces(const LaneKernel& kernel, const double* positions, cons
 
 }  // namespace
 
+namespace {
+
+/// Tets ahead of the current lane group whose vertex data is prefetched.
+constexpr int kPrefetchTets = 32;
+
+/// Prefetches position and force entries of the kLanes tets `tets`.
+inline void prefetch_vertices(const int* tets, const double* positions, const double* forces) {
+  for (int k = 0; k < 4 * detail::kLanes; ++k) {
+    __builtin_prefetch(positions + 3 * tets[k], 0, 3);
+    __builtin_prefetch(forces + 3 * tets[k], 1, 3);
+  }
+}
+
+}  // namespace
+
 template <typename Kernel>
 void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
                                      double* energy) const {
@@ -165,6 +180,8 @@ void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x,
       for (; i + detail::kLanes <= end; i += detail::kLanes) {
         const int group = i / detail::kLanes;
         const double* lane_Dm_inv = &m_lane_Dm_inv[9 * detail::kLanes * group];
+        if (i + kPrefetchTets + detail::kLanes <= end)
+          prefetch_vertices(&m_sorted_tets[4 * (i + kPrefetchTets)], positions, forces);
         sum += energy ? lane_group_forces<true>(lanes, positions, &m_sorted_tets[4 * i],
                                                 lane_Dm_inv, &m_sorted_volume[i], forces)
                       : lane_group_forces<false>(lanes, positions, &m_sorted_tets[4 * i],
