@@ -14,24 +14,16 @@ struct StvkStiffnessLanes {
   double mu, lambda;
   explicit StvkStiffnessLanes(const LameParameters& lame) : mu(lame.mu), lambda(lame.lambda) {}
 
-  /// Explicit 4-wide vectors: written as lane loops, GCC vectorised only part of this kernel.
-  using Vec = double __attribute__((vector_size(kLanes * sizeof(double))));
-
   void operator()(const double (&lane_F)[3][3][kLanes], const double* lane_Dm_inv,
                   const double* lane_volume, double (&K)[kLanes][12][12]) const {
-    const auto load = [](const double* p) {
-      Vec v;
-      __builtin_memcpy(&v, p, sizeof(Vec));
-      return v;
-    };
-    const Vec volume = load(lane_volume);
+    const Vec volume = load_vec(lane_volume);
     Vec F[3][3], g[4][3];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
-        F[r][c] = load(lane_F[r][c]);
+        F[r][c] = load_vec(lane_F[r][c]);
     for (int k = 1; k < 4; ++k)
       for (int d = 0; d < 3; ++d)
-        g[k][d] = load(lane_Dm_inv + (3 * d + k - 1) * kLanes);
+        g[k][d] = load_vec(lane_Dm_inv + (3 * d + k - 1) * kLanes);
     for (int d = 0; d < 3; ++d)
       g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
 

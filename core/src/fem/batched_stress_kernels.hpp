@@ -13,6 +13,18 @@ namespace strata::detail {
 inline constexpr int kLanes = 4;
 using Lanes = double[kLanes];
 
+/// Explicit 4-wide vectors (GCC/Clang vector extension) for kernels the compiler would otherwise
+/// vectorise only in part.
+using Vec = double __attribute__((vector_size(kLanes * sizeof(double))));
+inline Vec load_vec(const double* p) {
+  Vec v;
+  __builtin_memcpy(&v, p, sizeof(Vec));
+  return v;
+}
+inline void store_vec(double* p, const Vec& v) {
+  __builtin_memcpy(p, &v, sizeof(Vec));
+}
+
 /// F = Ds Dm⁻¹ of the kLanes tets `tets` (4 vertex indices each) at `positions` (3·#V).
 /// lane_Dm_inv[(3c + j) · kLanes + l] = Dm⁻¹(j, c) of lane l.
 [[gnu::always_inline]] inline void lane_deformation_gradient(const double* positions,
@@ -43,37 +55,33 @@ struct StvkLanes {
   explicit StvkLanes(const LameParameters& lame) : mu(lame.mu), lambda(lame.lambda) {}
 
   template <bool kWithEnergy>
-  void operator()(const double (&F)[3][3][kLanes], double (&P)[3][3][kLanes],
+  void operator()(const double (&lane_F)[3][3][kLanes], double (&P)[3][3][kLanes],
                   double (&psi)[kLanes]) const {
-    double E[3][3][kLanes];
-    for (int a = 0; a < 3; ++a)
-      for (int b = a; b < 3; ++b)
-        for (int l = 0; l < kLanes; ++l) {
-          const double dot =
-              F[0][a][l] * F[0][b][l] + F[1][a][l] * F[1][b][l] + F[2][a][l] * F[2][b][l];
-          E[a][b][l] = 0.5 * (dot - (a == b ? 1.0 : 0.0));
-          E[b][a][l] = E[a][b][l];
-        }
-    double trace[kLanes];
-    for (int l = 0; l < kLanes; ++l)
-      trace[l] = E[0][0][l] + E[1][1][l] + E[2][2][l];
-    double S[3][3][kLanes];
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b)
-        for (int l = 0; l < kLanes; ++l)
-          S[a][b][l] = 2.0 * mu * E[a][b][l] + (a == b ? lambda * trace[l] : 0.0);
+    Vec F[3][3];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
-        for (int l = 0; l < kLanes; ++l)
-          P[r][c][l] = F[r][0][l] * S[0][c][l] + F[r][1][l] * S[1][c][l] + F[r][2][l] * S[2][c][l];
-    if constexpr (kWithEnergy) {
-      for (int l = 0; l < kLanes; ++l) {
-        double squared = 0.0;
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b)
-            squared += E[a][b][l] * E[a][b][l];
-        psi[l] = mu * squared + 0.5 * lambda * trace[l] * trace[l];
+        F[r][c] = load_vec(lane_F[r][c]);
+    Vec E[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = a; b < 3; ++b) {
+        E[a][b] = 0.5 * (F[0][a] * F[0][b] + F[1][a] * F[1][b] + F[2][a] * F[2][b]);
+        if (a == b) E[a][b] -= 0.5;
+        E[b][a] = E[a][b];
       }
+    const Vec trace = E[0][0] + E[1][1] + E[2][2];
+    Vec S[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        S[a][b] = (2.0 * mu) * E[a][b] + (a == b ? lambda * trace : Vec{});
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        store_vec(P[r][c], F[r][0] * S[0][c] + F[r][1] * S[1][c] + F[r][2] * S[2][c]);
+    if constexpr (kWithEnergy) {
+      Vec squared{};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          squared += E[a][b] * E[a][b];
+      store_vec(psi, mu * squared + (0.5 * lambda) * trace * trace);
     }
   }
 };
