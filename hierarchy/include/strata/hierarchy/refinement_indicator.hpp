@@ -14,8 +14,8 @@
 
 namespace strata {
 
-/// Interface of a refinement criterion. Implementations are stateless (evaluate is const and may
-/// be called concurrently on different states).
+/// Interface of a refinement criterion. `evaluate` is const and safe to call concurrently on
+/// different states (implementations keep at most internally guarded caches).
 class RefinementIndicator {
  public:
   virtual ~RefinementIndicator() = default;
