@@ -115,6 +115,9 @@ ForceReference ForceIndicator::reference(const CutState& state) const {
 void ForceIndicator::evaluate(const CutState& state, VectorXd& eta) const {
   const ForceParts parts = force_parts(state, m_stress_floor, cached_surface_area(state.tree));
   const MatrixX4i& tets = state.flat.mesh.tets;
+  const VectorXd* traction = state.finest_load_traction;
+  STRATA_VERIFY(!traction || traction->size() == tets.rows(),
+                "ForceIndicator: finest_load_traction must have one entry per flat tet");
   eta.resize(tets.rows());
   for (Index t = 0; t < tets.rows(); ++t) {
     double density = voigt_frobenius_norm(state.fields.cauchy_stress.row(t).transpose());
@@ -123,6 +126,7 @@ void ForceIndicator::evaluate(const CutState& state, VectorXd& eta) const {
       if (parts.areas[v] > 0.0)
         density = std::max(density, parts.loads.segment<3>(3 * v).norm() / parts.areas[v]);
     }
+    if (traction) density = std::max(density, (*traction)[t]);
     eta[t] = density / parts.reference.scale;
   }
 }

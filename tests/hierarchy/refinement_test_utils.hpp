@@ -3,6 +3,7 @@
 // fields and finest-level point loads on a flattened cut, as the adaptive driver would fill it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -27,6 +28,7 @@ using DisplacementField = std::function<Vector3d(const Vector3d&)>;
 struct PointLoad {
   Vector3d point;
   Vector3d force;
+  double area = 0.0;  ///< loaded surface area it stands for [m²]; > 0: reported as a traction
 };
 
 /// Everything a CutState refers to, owned.
@@ -39,10 +41,18 @@ struct CutSnapshot {
   VectorXd vertex_mass;
   Material material;
   long step = 0;
+  VectorXd finest_traction;  ///< #T, or empty (no finest-level tractions reported)
 
   CutState state() const {
-    return CutState{*tree,           cut.flat,    positions, fields,
-                    external_forces, vertex_mass, material,  step};
+    return CutState{*tree,
+                    cut.flat,
+                    positions,
+                    fields,
+                    external_forces,
+                    vertex_mass,
+                    material,
+                    step,
+                    finest_traction.size() > 0 ? &finest_traction : nullptr};
   }
 };
 
@@ -65,7 +75,7 @@ inline TreeLocation active_location(const ActiveCut& cut, const TreePointLocator
 inline CutSnapshot make_snapshot(const ActiveCut& cut, const Material& material,
                                  const DisplacementField& u, const std::vector<PointLoad>& loads,
                                  const Vector3d& gravity = Vector3d::Zero(), long step = 0) {
-  CutSnapshot s{&cut.tree(), flatten_cut(cut), {}, {}, {}, {}, material, step};
+  CutSnapshot s{&cut.tree(), flatten_cut(cut), {}, {}, {}, {}, material, step, {}};
   const TetMesh& mesh = s.cut.flat.mesh;
   const HangingConstraints& hc = s.cut.constraints;
   VectorXd x = flatten(mesh.vertices);
@@ -84,6 +94,13 @@ inline CutSnapshot make_snapshot(const ActiveCut& cut, const Material& material,
     for (const PointLoad& load : loads) {
       const TreeLocation at = active_location(cut, locator, load.point);
       const std::array<int, 4> corners = cut.tree().tet_vertices(at.node);
+      if (load.area > 0.0) {
+        if (s.finest_traction.size() == 0) s.finest_traction = VectorXd::Zero(mesh.tets.rows());
+        const auto t =
+            std::find(s.cut.flat.tet_nodes.begin(), s.cut.flat.tet_nodes.end(), at.node) -
+            s.cut.flat.tet_nodes.begin();
+        s.finest_traction[t] = std::max(s.finest_traction[t], load.force.norm() / load.area);
+      }
       for (int i = 0; i < 4; ++i)
         s.external_forces.segment<3>(3 * s.cut.flat.mesh_vertices[corners[i]]) +=
             at.barycentric[i] * load.force;

@@ -106,6 +106,35 @@ TEST(RefinementController, PatchInsideACoarseTetRefinesThere) {
   expect_refinement_near(cut, centre, 0.35);
 }
 
+// A stressed body (uniform stress with its tractions) with a small, strongly loaded patch inside
+// one coarse tet: the patch's forces, smeared over the coarse corners, are weak against the body's
+// stress, so only the finest-level traction reported by the driver refines it — down to the
+// finest level, and only where the patch is.
+TEST(RefinementController, FinestLoadTractionRefinesAPatchUnderStress) {
+  const Vector3d centre(0.61, 0.43, 0.25);
+  const double patch_area = M_PI * 0.01 * 0.01;
+  for (const bool report_traction : {false, true}) {
+    TetTree tree(slab(), 3);
+    RefinementController controller(fast_settings());
+    ActiveCut cut(tree);
+    Scene scene = affine_scene();
+    for (int k = 0; k < 4; ++k)
+      scene.loads.push_back({centre + 0.005 * Vector3d(k % 2, k / 2, 0.0),
+                             Vector3d(0.0, 0.0, -10.0), report_traction ? patch_area / 4 : 0.0});
+    long step = 0;
+    run_to_steady(controller, cut, scene, step, 10);
+    const TreePointLocator locator(tree);
+    const int level = tree.level(active_location(cut, locator, centre).node);
+    if (!report_traction) {
+      EXPECT_EQ(cut.size(), tree.num_roots());  // η ≤ 1 + (smeared patch) < 3 everywhere
+      continue;
+    }
+    EXPECT_EQ(level, 3);
+    expect_refinement_near(cut, centre, 0.2);
+    EXPECT_LT(cut.size(), tree.num_roots() + 7 * 3 * 4 * 2);  // a path per patch point and level
+  }
+}
+
 TEST(RefinementController, SteadyStateDoesNotFlicker) {
   TetTree tree(test::slab(), 3);
   RefinementController controller(fast_settings());  // no minimum steps: the worst case

@@ -35,6 +35,12 @@ struct CutState {
   const Material& material;
   /// The driver's step counter (for the controller's hysteresis in steps).
   long step = 0;
+  /// Optional, #T: per flat tet the largest traction [Pa] of the finest-level loads acting inside
+  /// it (|f_i| / a_i of each loaded finest vertex i embedded in the tet, a_i its share of the
+  /// loaded surface area; 0 where no load acts). Lets the force indicator see how concentrated a
+  /// load is at the finest level, which the flat vertices' forces smear over coarse tets. Null:
+  /// only `external_forces` are used.
+  const VectorXd* finest_load_traction = nullptr;
 };
 
 }  // namespace strata

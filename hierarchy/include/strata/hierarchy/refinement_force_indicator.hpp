@@ -21,6 +21,11 @@
 ///   stress field has |f_v| ≤ ‖σ‖_F c_v. Loads enter through `external_forces`, so a small loaded
 ///   patch inside a coarse tet (no coarse vertex in it) pulls on that tet's vertices through its
 ///   barycentric weights and is seen even before the body has responded.
+/// - τ_t, the finest-level load traction inside the tet (CutState::finest_load_traction, when the
+///   driver supplies it; else 0): it enters like the load density, η_t = max(‖σ_t‖_F, |g_v|/c_v,
+///   τ_t) / s_ref. Unlike |g_v|/c_v it does not shrink on a coarse cut, so a small, strongly loaded
+///   patch keeps its tets refining down to the finest level even after the body's stresses have
+///   built up (a uniform traction equal to the stress it causes still gives η ≈ 1).
 /// - s_ref = max(S_σ, S_load, floor · E), the body's stress scale [Pa]:
 ///   S_σ = √(Σ_t V_t ‖σ_t‖_F² / Σ V_t), the volume-RMS stress (refinement_indicator.hpp);
 ///   S_load = √(Σ_v |g_v|² / c_v / A_∂), the RMS traction the loads would exert if spread over the
