@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "strata/app/fine_surface.hpp"
 #include "strata/app/progress_bar.hpp"
 #include "strata/app/run_outputs.hpp"
 #include "strata/app/vtk_series.hpp"
@@ -16,6 +17,7 @@
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
+#include "strata/meshing/surface_io.hpp"
 
 namespace strata::app {
 namespace {
@@ -167,12 +169,27 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");
   std::optional<VtkSeries> vtk;
   if (scene.output.vtk) vtk.emplace(summary.output_dir, scene.name);
+  std::optional<FineSurface> surface;  // the render surface, bound to the simulation mesh
+  if (vtk && scene.mesh.surface) {
+    surface.emplace(read_surface(*scene.mesh.surface), prepared.mesh);
+    if (!options.quiet) {
+      log << "strata: surface " << scene.mesh.surface->string() << ": "
+          << surface->rest().vertices.rows() << " vertices bound in "
+          << format_duration(surface->bind_seconds()) << " (" << surface->binding().num_outside
+          << " outside the mesh, at most " << surface->max_outside_distance() << " m)\n";
+    }
+  }
 
   const auto write_frame = [&]() {
     const double time = simulation->time();
     probes.record(time, simulation->positions() - simulation->model().rest_positions());
     reactions.record(time, simulation->reactions());
     if (vtk) vtk->write_frame(time, *simulation);
+    if (vtk && surface && surface->matches(simulation->mesh())) {
+      const MatrixX3d surface_positions = surface->positions(simulation->positions());
+      vtk->write_surface_frame(time, surface_positions, surface->rest().triangles,
+                               surface->fields(surface_positions));
+    }
     ++summary.frames;
   };
   const auto save_tables = [&]() {

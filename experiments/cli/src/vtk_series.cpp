@@ -1,8 +1,10 @@
 #include "strata/app/vtk_series.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <regex>
 
+#include "strata/core/io/vtp.hpp"
 #include "strata/core/io/vtu.hpp"
 
 namespace strata::app {
@@ -13,7 +15,8 @@ std::filesystem::path prepare_series(const std::filesystem::path& folder, const 
   std::error_code error;
   if (!std::filesystem::is_directory(folder, error)) return folder / (stem + ".pvd");
   const std::regex frame_name(
-      std::regex_replace(stem, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") + R"(_\d{6}\.vtu)");
+      std::regex_replace(stem, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
+      R"((_surface)?_\d{6}\.vt[up])");
   for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
     if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), frame_name)) {
       std::filesystem::remove(entry.path(), error);
@@ -45,6 +48,15 @@ void VtkSeries::write_frame(double time, const Simulation& simulation) {
   write_vtu(m_folder / file, positions, mesh.tets, fields);
   m_pvd.add_frame(time, file);
   ++m_frames;
+}
+
+void VtkSeries::write_surface_frame(double time, ConstRef<MatrixX3d> positions,
+                                    ConstRef<MatrixX3i> triangles, const VtuFields& fields) {
+  char name[40];
+  std::snprintf(name, sizeof name, "_surface_%06d.vtp", std::max(m_frames - 1, 0));
+  const std::string file = m_stem + name;
+  write_vtp(m_folder / file, positions, triangles, fields);
+  m_pvd.add_frame(time, file, 1);
 }
 
 }  // namespace strata::app
