@@ -27,6 +27,7 @@ struct LevelSetOptions {
 
 /// A narrow-band signed distance grid (value type: float). Copies are deep; moves are cheap.
 /// Queries are const and may run concurrently; no method modifies a grid in place.
+/// A moved-from LevelSet may only be assigned to or destroyed.
 class LevelSet {
  public:
   LevelSet();  ///< an empty grid (φ = background everywhere)
