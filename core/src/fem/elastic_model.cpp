@@ -137,10 +137,6 @@ double lane_group_forces(const LaneKernel& kernel, const double* positions, cons
   return energy;
 }
 
-}  // namespace
-
-namespace {
-
 /// Tets ahead of the current lane group whose vertex data is prefetched.
 constexpr int kPrefetchTets = 32;
 
