@@ -54,8 +54,15 @@ Vector3d ProbeRecorder::probe_displacement(std::size_t i, ConstRef<VectorXd> dis
 }
 
 void ProbeRecorder::record(double time, ConstRef<VectorXd> displacement) {
+  MatrixX3d u(static_cast<Index>(m_probes.size()), 3);
+  for (std::size_t i = 0; i < m_probes.size(); ++i)
+    u.row(static_cast<Index>(i)) = probe_displacement(i, displacement).transpose();
+  record_displacements(time, u);
+}
+
+void ProbeRecorder::record_displacements(double time, ConstRef<MatrixX3d> displacements) {
   for (std::size_t i = 0; i < m_probes.size(); ++i) {
-    const Vector3d u = probe_displacement(i, displacement);
+    const Vector3d u = displacements.row(static_cast<Index>(i)).transpose();
     std::ostringstream row;
     write_double(row, time);
     row << ',' << i;

@@ -4,6 +4,7 @@
 #include <regex>
 #include <sstream>
 
+#include "scene_hierarchy.hpp"
 #include "scene_json.hpp"
 #include "strata/app/scene_overrides.hpp"
 
@@ -234,7 +235,7 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   const std::string file_name = file.string();
   const SceneValue top(root, "", file_name);
   top.expect_object({"mesh", "material", "gravity", "fixed", "prescribed", "forces", "ground",
-                     "solver", "output"});
+                     "solver", "output", "hierarchy"});
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();
@@ -272,6 +273,7 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   }
   scene.solver = parse_solver(top.at("solver"));
   if (top.has("output")) scene.output = parse_output(top.at("output"));
+  if (top.has("hierarchy")) scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"));
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {
     throw SceneKeyError(file_name, "fixed",

@@ -18,6 +18,7 @@
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/meshing/surface_io.hpp"
+#include "strata/hierarchy/adaptive_simulation.hpp"
 
 namespace strata::app {
 namespace {
@@ -35,19 +36,99 @@ long planned_steps(const SolverSettings& settings) {
   return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
 }
 
-/// Builds the Simulation; core InputErrors get the scene file as prefix.
-std::unique_ptr<Simulation> make_simulation(const Scene& scene, TetMesh mesh) {
-  try {
-    return std::make_unique<Simulation>(std::move(mesh), scene.material, scene.dirichlet_groups(),
-                                        scene.forces, scene.ground, scene.gravity, scene.solver);
-  } catch (const InputError& error) {
-    throw InputError(scene.file.string() + ": " + error.what());
+/// The scene's simulation: a plain Simulation on the mesh, or (scene key "hierarchy") an
+/// AdaptiveSimulation on an active cut of the refinement tree over it. The runner only uses this
+/// class, so every output is written the same way for both.
+class SceneSimulation {
+ public:
+  /// Core InputErrors get the scene file as prefix.
+  SceneSimulation(const Scene& scene, const TetMesh& mesh) {
+    try {
+      if (scene.hierarchy) {
+        m_adaptive = std::make_unique<AdaptiveSimulation>(
+            mesh, *scene.hierarchy, scene.material, scene.dirichlet_groups(), scene.forces,
+            scene.ground, scene.gravity, scene.solver);
+      } else {
+        m_plain =
+            std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
+                                         scene.forces, scene.ground, scene.gravity, scene.solver);
+      }
+    } catch (const InputError& error) {
+      throw InputError(scene.file.string() + ": " + error.what());
+    }
   }
+  void advance() { m_adaptive ? m_adaptive->advance() : m_plain->advance(); }
+  bool finished() const { return current().finished(); }
+  /// The Simulation of the current mesh (the active cut's, for a hierarchy).
+  const Simulation& current() const { return m_adaptive ? m_adaptive->simulation() : *m_plain; }
+  const AdaptiveSimulation* adaptive() const { return m_adaptive.get(); }
+  SimulationCounters counters() const {
+    return m_adaptive ? m_adaptive->counters() : m_plain->counters();
+  }
+
+ private:
+  std::unique_ptr<Simulation> m_plain;
+  std::unique_ptr<AdaptiveSimulation> m_adaptive;
+};
+
+/// stats.json's "hierarchy" block: settings, the active-cut history and every cut change.
+nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
+  const HierarchySettings& settings = adaptive.settings();
+  nlohmann::json block;
+  block["mode"] = to_string(settings.mode);
+  block["levels"] = settings.levels;
+  block["level"] = settings.level;
+  block["indicator"] = settings.indicator;
+  block["refine_threshold"] = settings.criteria.refine_threshold;
+  block["coarsen_tolerance"] = settings.criteria.coarsen_tolerance;
+  block["root_tets"] = adaptive.tree().num_roots();
+  block["finest_level_tets"] =
+      static_cast<double>(adaptive.tree().num_roots()) * std::pow(8.0, settings.levels);
+  block["tree_nodes"] = adaptive.tree().num_nodes();
+  block["tree_memory_bytes"] = adaptive.tree().memory_bytes();
+  block["active_level_counts"] = adaptive.cut().level_counts();
+  block["bookkeeping_seconds"] = adaptive.bookkeeping_seconds();
+  block["stepping_seconds"] = adaptive.stepping_seconds();
+  nlohmann::json history = {{"step", nlohmann::json::array()},
+                            {"time", nlohmann::json::array()},
+                            {"tets", nlohmann::json::array()},
+                            {"dofs", nlohmann::json::array()},
+                            {"hanging_vertices", nlohmann::json::array()}};
+  for (const CutSample& sample : adaptive.history()) {
+    history["step"].push_back(sample.step);
+    history["time"].push_back(sample.time);
+    history["tets"].push_back(sample.tets);
+    history["dofs"].push_back(sample.dofs);
+    history["hanging_vertices"].push_back(sample.hanging);
+  }
+  block["history"] = history;
+  Index refinements = 0, coarsenings = 0;
+  nlohmann::json changes = nlohmann::json::array();
+  for (const CutChangeRecord& change : adaptive.changes()) {
+    refinements += change.refined;
+    coarsenings += change.coarsened;
+    changes.push_back({{"step", change.step},
+                       {"pass", change.pass},
+                       {"time", change.time},
+                       {"refined", change.refined},
+                       {"coarsened", change.coarsened},
+                       {"tets_before", change.tets_before},
+                       {"tets_after", change.tets_after},
+                       {"dofs_after", change.dofs_after},
+                       {"energy_before", change.energy_before},
+                       {"energy_after", change.energy_after},
+                       {"seconds", change.seconds}});
+  }
+  block["refinements"] = refinements;
+  block["coarsenings"] = coarsenings;
+  block["changes"] = changes;
+  return block;
 }
 
 nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
-                          const Simulation& simulation, const RunSummary& summary) {
-  const SimulationCounters counters = simulation.counters();
+                          const SceneSimulation& scene_simulation, const RunSummary& summary) {
+  const Simulation& simulation = scene_simulation.current();
+  const SimulationCounters counters = scene_simulation.counters();
   nlohmann::json stats;
   stats["status"] = summary.status;
   if (!summary.message.empty()) stats["message"] = summary.message;
@@ -59,14 +140,14 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   stats["factorizations"] = counters.factorizations;
   stats["vertices"] = simulation.mesh().vertices.rows();
   stats["tets"] = simulation.mesh().tets.rows();
-  stats["dofs"] = 3 * simulation.mesh().vertices.rows();
+  stats["dofs"] = simulation.embedded_model().num_dofs();
   Index constrained = 0;
   std::vector<std::string> groups;
   for (const DirichletGroup& group : simulation.dirichlet_groups()) {
     constrained += 3 * static_cast<Index>(group.vertices.size());
     groups.push_back(group.spec.name);
   }
-  stats["free_dofs"] = 3 * simulation.mesh().vertices.rows() - constrained;
+  stats["free_dofs"] = simulation.embedded_model().num_dofs() - constrained;
   stats["groups"] = groups;
   stats["mesh_source"] = prepared.source;
   stats["reoriented_tets"] = prepared.reoriented_tets;
@@ -102,6 +183,8 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   }
   stats["frames"] = summary.frames;
   stats["probes"] = scene.output.probes.size();
+  if (scene_simulation.adaptive())
+    stats["hierarchy"] = hierarchy_json(*scene_simulation.adaptive());
   return stats;
 }
 
@@ -132,8 +215,17 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   } catch (const InputError& error) {
     throw InputError(scene.file.string() + ": " + error.what());
   }
-  std::unique_ptr<Simulation> simulation = make_simulation(scene, prepared.mesh);
+  SceneSimulation scene_simulation(scene, prepared.mesh);
+  const Simulation* simulation = &scene_simulation.current();
   summary.stable_dt_estimate = simulation->stable_dt_estimate();
+  std::vector<RootPoint> probe_roots;
+  if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive()) {
+    try {
+      probe_roots = adaptive->locate(probe_points, "output.probes");
+    } catch (const InputError& error) {
+      throw InputError(scene.file.string() + ": " + error.what());
+    }
+  }
 
   if (!options.quiet) {
     log << "strata: " << scene.file.string() << ": " << prepared.mesh.vertices.rows()
@@ -141,6 +233,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     if (prepared.reoriented_tets > 0) log << " (" << prepared.reoriented_tets << " reoriented)";
     if (prepared.removed_vertices > 0) {
       log << " (" << prepared.removed_vertices << " unreferenced vertices removed)";
+    }
+    if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive()) {
+      log << "; hierarchy " << to_string(adaptive->settings().mode) << ", "
+          << adaptive->settings().levels << " levels, " << adaptive->cut().size() << " active tets";
     }
     log << ", " << to_string(scene.material.model) << ", " << to_string(scene.solver.mode);
     if (scene.solver.mode == SimulationMode::dynamic) {
@@ -181,10 +277,19 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   }
 
   const auto write_frame = [&]() {
+    simulation = &scene_simulation.current();  // a hierarchy rebuilds it when the cut changes
     const double time = simulation->time();
-    probes.record(time, simulation->positions() - simulation->model().rest_positions());
+    const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
+    if (adaptive) {
+      probes.record_displacements(time, adaptive->displacements(probe_roots));
+    } else {
+      probes.record(time, simulation->positions() - simulation->model().rest_positions());
+    }
     reactions.record(time, simulation->reactions());
-    if (vtk) vtk->write_frame(time, *simulation);
+    if (vtk) {
+      const VectorXi levels = adaptive ? adaptive->cell_levels() : VectorXi();
+      vtk->write_frame(time, *simulation, adaptive ? &levels : nullptr);
+    }
     if (vtk && surface && surface->matches(simulation->mesh())) {
       const MatrixX3d surface_positions = surface->positions(simulation->positions());
       vtk->write_surface_frame(time, surface_positions, surface->rest().triangles,
@@ -197,10 +302,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     reactions.csv().save();
   };
   const auto finish = [&]() {
-    summary.steps = simulation->step_count();
+    summary.steps = scene_simulation.current().step_count();
     summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     write_json(summary.output_dir / "stats.json",
-               stats_json(scene, prepared, *simulation, summary));
+               stats_json(scene, prepared, scene_simulation, summary));
   };
 
   write_frame();
@@ -208,8 +313,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   const long total_steps = planned_steps(scene.solver);
   ProgressBar progress(options.progress);
   try {
-    while (!simulation->finished()) {
-      simulation->advance();
+    while (!scene_simulation.finished()) {
+      scene_simulation.advance();
+      simulation = &scene_simulation.current();
       const long step = simulation->step_count();
       if (step % scene.output.every == 0 || simulation->finished()) {
         write_frame();

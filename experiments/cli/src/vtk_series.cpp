@@ -30,7 +30,7 @@ std::filesystem::path prepare_series(const std::filesystem::path& folder, const 
 VtkSeries::VtkSeries(const std::filesystem::path& folder, const std::string& stem)
     : m_folder(folder), m_stem(stem), m_pvd(prepare_series(folder, stem)) {}
 
-void VtkSeries::write_frame(double time, const Simulation& simulation) {
+void VtkSeries::write_frame(double time, const Simulation& simulation, const VectorXi* levels) {
   const TetMesh& mesh = simulation.mesh();
   const MatrixX3d positions = unflatten(simulation.positions());
   const TetFields tet_fields = simulation.model().tet_fields(simulation.positions());
@@ -40,7 +40,9 @@ void VtkSeries::write_frame(double time, const Simulation& simulation) {
   fields.add_cell_data("green_strain", Eigen::MatrixXd(tet_fields.green_strain));
   fields.add_cell_data("stress", Eigen::MatrixXd(tet_fields.cauchy_stress));
   fields.add_cell_data("von_mises", Eigen::MatrixXd(tet_fields.von_mises));
-  fields.add_cell_data("level", Eigen::MatrixXi(Eigen::MatrixXi::Zero(mesh.tets.rows(), 1)));
+  fields.add_cell_data("level", levels
+                                    ? Eigen::MatrixXi(*levels)
+                                    : Eigen::MatrixXi(Eigen::MatrixXi::Zero(mesh.tets.rows(), 1)));
 
   char name[32];
   std::snprintf(name, sizeof name, "_%06d.vtu", m_frames);

@@ -49,6 +49,9 @@ class ProbeRecorder {
 
   /// Adds the rows of one frame: `displacement` is x − X, 3·#V.
   void record(double time, ConstRef<VectorXd> displacement);
+  /// Adds the rows of one frame from the probes' displacements (#probes × 3), computed elsewhere
+  /// (e.g. on the active cut of a refinement tree).
+  void record_displacements(double time, ConstRef<MatrixX3d> displacements);
   CsvSeries& csv() { return m_csv; }
 
   /// Displacement of probe `i` for a 3·#V displacement vector.

@@ -15,6 +15,7 @@
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/solver_settings.hpp"
+#include "strata/hierarchy/adaptive_simulation.hpp"
 #include "strata/meshing/meshing_options.hpp"
 
 namespace strata::app {
@@ -52,6 +53,9 @@ struct Scene {
   std::optional<GroundPlane> ground;
   SolverSettings solver;
   OutputSpec output;
+  /// "hierarchy": run on an active cut of a refinement tree over the mesh (full, uniform or
+  /// adaptive); absent: the mesh itself, as a plain Simulation.
+  std::optional<HierarchySettings> hierarchy;
 
   /// fixed groups first, then prescribed ones: the order of reactions.csv's `group` column.
   std::vector<DirichletSpec> dirichlet_groups() const;

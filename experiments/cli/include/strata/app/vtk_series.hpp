@@ -21,7 +21,8 @@ class VtkSeries {
   VtkSeries(const std::filesystem::path& folder, const std::string& stem);
 
   /// Writes the simulation's current state as the next frame at `time` (load factor when static).
-  void write_frame(double time, const Simulation& simulation);
+  /// `levels` (#T, optional): the tree level of each cell (active cut of a hierarchy); 0 without.
+  void write_frame(double time, const Simulation& simulation, const VectorXi* levels = nullptr);
 
   /// Writes the fine surface of the last frame: `positions` #Vs × 3, `triangles` #F × 3 and point
   /// `fields`, as `<stem>_surface_NNNNNN.vtp`, part 1 of the .pvd at `time`.

@@ -1,0 +1,59 @@
+#include "scene_hierarchy.hpp"
+
+#include "strata/core/common/error.hpp"
+
+namespace strata::app::detail {
+
+HierarchySettings parse_hierarchy(const SceneValue& value) {
+  value.expect_object({"levels", "mode", "level", "adapt_every", "max_passes", "indicator",
+                       "refine_threshold", "coarsen_tolerance", "coarsen_indicator_fraction",
+                       "stress_floor", "min_steps_between_changes", "max_active_elements",
+                       "max_level", "balance"});
+  HierarchySettings settings;
+  settings.levels = value.at("levels").integer(0);
+  if (settings.levels > 8) value.at("levels").fail("must be at most 8");
+  if (value.has("mode")) {
+    settings.mode =
+        static_cast<HierarchyMode>(value.at("mode").choice({"full", "uniform", "adaptive"}));
+  }
+  if (value.has("level")) {
+    settings.level = value.at("level").integer(0);
+    if (settings.level > settings.levels) value.at("level").fail("must be at most levels");
+  } else if (settings.mode == HierarchyMode::uniform) {
+    value.fail("mode \"uniform\" needs \"level\"");
+  }
+  if (value.has("adapt_every")) settings.adapt_every = value.at("adapt_every").integer(1);
+  if (value.has("max_passes")) settings.max_passes = value.at("max_passes").integer(1);
+  if (value.has("indicator")) {
+    settings.indicator =
+        value.at("indicator").choice({"force", "stress_jump"}) == 0 ? "force" : "stress_jump";
+  }
+  RefinementSettings& criteria = settings.criteria;
+  if (value.has("refine_threshold"))
+    criteria.refine_threshold = value.at("refine_threshold").positive();
+  if (value.has("coarsen_tolerance"))
+    criteria.coarsen_tolerance = value.at("coarsen_tolerance").positive();
+  if (value.has("coarsen_indicator_fraction")) {
+    criteria.coarsen_indicator_fraction = value.at("coarsen_indicator_fraction").positive();
+    if (criteria.coarsen_indicator_fraction > 1.0)
+      value.at("coarsen_indicator_fraction").fail("must be in (0, 1]");
+  }
+  if (value.has("stress_floor")) criteria.stress_floor = value.at("stress_floor").positive();
+  if (value.has("min_steps_between_changes"))
+    criteria.min_steps_between_changes = value.at("min_steps_between_changes").integer(0);
+  if (value.has("max_active_elements"))
+    criteria.max_active_elements = value.at("max_active_elements").integer(0);
+  if (value.has("max_level")) {
+    criteria.max_level = value.at("max_level").integer(0);
+    if (criteria.max_level > settings.levels) value.at("max_level").fail("must be at most levels");
+  }
+  if (value.has("balance")) criteria.balance = value.at("balance").boolean();
+  try {
+    validate_hierarchy_settings(settings, value.path());
+  } catch (const InputError& error) {
+    value.fail(error.what());
+  }
+  return settings;
+}
+
+}  // namespace strata::app::detail

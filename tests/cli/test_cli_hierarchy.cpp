@@ -1,0 +1,148 @@
+// End-to-end runs of scenes with a "hierarchy" key: the three modes through the CLI, the outputs
+// that describe the active cut (per-cell level, stats history), probes against the full
+// resolution, and bad hierarchy keys.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "cli_test_utils.hpp"
+
+namespace strata::cli_test {
+namespace {
+
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+/// A 1 × 1 × 0.25 m slab of 4 × 4 × 1 cells fixed at the bottom and pressed by a 0.2 × 0.2 m
+/// patch on top, with a two-level tree.
+json slab_scene(const std::string& mode) {
+  json scene = json::parse(R"({
+    "mesh": {"box": {"min": [0, 0, 0], "max": [1, 1, 0.25], "cells": [4, 4, 1]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e6, "poisson_ratio": 0.3,
+                 "density": 1000},
+    "fixed": [{"plane": {"point": [0, 0, 0], "normal": [0, 0, 1]}}],
+    "forces": [{"region": {"box": {"min": [0.4, 0.4, 0.25], "max": [0.6, 0.6, 0.25]}},
+                "total_force": [0, 0, -500]}],
+    "solver": {"mode": "static", "load_steps": 2},
+    "output": {"probes": [[0.5, 0.5, 0.25], [0.1, 0.1, 0.25]]},
+    "hierarchy": {"levels": 2, "level": 0, "indicator": "stress_jump", "refine_threshold": 0.3}
+  })");
+  scene["hierarchy"]["mode"] = mode;
+  return scene;
+}
+
+struct SlabRun {
+  double probe_uz = 0.0;
+  json stats;
+  std::string last_vtu;
+};
+
+SlabRun run_slab(const TempFolder& folder, const std::string& mode) {
+  write_text(folder.path() / (mode + ".json"), slab_scene(mode).dump(2));
+  const CliResult result = run_strata("run " + mode + ".json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  const std::filesystem::path out = folder.path() / "out" / mode;
+  SlabRun run;
+  const Csv probes = read_csv(out / "probes.csv");
+  EXPECT_EQ(probes.rows.size(), 6u);  // 3 frames × 2 probes
+  if (probes.rows.size() >= 2) run.probe_uz = probes.rows[probes.rows.size() - 2][7];
+  run.stats = read_json(out / "stats.json");
+  run.last_vtu = read_text(out / (mode + "_000002.vtu"));
+  return run;
+}
+
+/// The per-cell "level" values of a .vtu written by strata (ASCII data arrays). Plain string
+/// search: std::regex recurses per character and overflows the stack on long arrays.
+std::vector<int> cell_levels(const std::string& vtu) {
+  std::vector<int> levels;
+  const std::size_t name = vtu.find("Name=\"level\"");
+  if (name == std::string::npos) return levels;
+  const std::size_t begin = vtu.find('>', name);
+  const std::size_t end = vtu.find("</DataArray>", begin);
+  if (begin == std::string::npos || end == std::string::npos) return levels;
+  std::stringstream values(vtu.substr(begin + 1, end - begin - 1));
+  int level;
+  while (values >> level)
+    levels.push_back(level);
+  return levels;
+}
+
+TEST(CliHierarchy, AdaptiveRunRefinesNearTheLoadAndMatchesFullResolution) {
+  TempFolder folder;
+  const SlabRun full = run_slab(folder, "full");
+  const SlabRun uniform = run_slab(folder, "uniform");
+  const SlabRun adaptive = run_slab(folder, "adaptive");
+  ASSERT_LT(full.probe_uz, 0.0);
+  const double full_tets = full.stats["tets"].get<double>();
+  const double adaptive_tets = adaptive.stats["tets"].get<double>();
+  EXPECT_EQ(full_tets, 96.0 * 64.0);
+  EXPECT_EQ(uniform.stats["tets"].get<double>(), 96.0);
+  EXPECT_LT(adaptive_tets, full_tets / 3.0);
+  const double uniform_error = std::abs(uniform.probe_uz - full.probe_uz);
+  const double adaptive_error = std::abs(adaptive.probe_uz - full.probe_uz);
+  EXPECT_LT(adaptive_error, 0.25 * uniform_error);
+
+  // The cut is described in stats.json and in the .vtu's level field.
+  const json& hierarchy = adaptive.stats["hierarchy"];
+  EXPECT_EQ(hierarchy["mode"], "adaptive");
+  EXPECT_GT(hierarchy["refinements"].get<int>(), 0);
+  ASSERT_FALSE(hierarchy["changes"].empty());
+  EXPECT_EQ(hierarchy["history"]["tets"].back().get<double>(), adaptive_tets);
+  const std::vector<int> levels = cell_levels(adaptive.last_vtu);
+  ASSERT_EQ(static_cast<double>(levels.size()), adaptive_tets);
+  EXPECT_EQ(*std::max_element(levels.begin(), levels.end()), 2);
+  EXPECT_EQ(*std::min_element(levels.begin(), levels.end()), 0);
+  const std::vector<int> full_levels = cell_levels(full.last_vtu);
+  EXPECT_EQ(*std::min_element(full_levels.begin(), full_levels.end()), 2);
+}
+
+TEST(CliHierarchy, BadHierarchyKeysNameTheKey) {
+  TempFolder folder;
+  json scene = slab_scene("adaptive");
+  scene["hierarchy"]["mode"] = "sometimes";
+  write_text(folder.path() / "bad.json", scene.dump());
+  CliResult result = run_strata("run bad.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("hierarchy.mode"));
+
+  result = run_strata("run adaptive_bad_level.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);  // missing file
+
+  scene = slab_scene("uniform");
+  scene["hierarchy"]["level"] = 3;
+  write_text(folder.path() / "level.json", scene.dump());
+  result = run_strata("run level.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("hierarchy.level"));
+
+  scene = slab_scene("adaptive");
+  scene["hierarchy"]["refine_threshold"] = -1;
+  write_text(folder.path() / "threshold.json", scene.dump());
+  result = run_strata("run threshold.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("hierarchy.refine_threshold"));
+
+  scene = slab_scene("adaptive");
+  scene["hierarchy"]["spline"] = true;
+  write_text(folder.path() / "unknown.json", scene.dump());
+  result = run_strata("run unknown.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("hierarchy.spline"));
+}
+
+TEST(CliHierarchy, SetOverridesSwitchTheMode) {
+  TempFolder folder;
+  write_text(folder.path() / "slab.json", slab_scene("adaptive").dump(2));
+  const CliResult result = run_strata(
+      "run slab.json --quiet --set hierarchy.mode=uniform --set hierarchy.level=1", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json stats = read_json(folder.path() / "out" / "slab" / "stats.json");
+  EXPECT_EQ(stats["tets"].get<double>(), 96.0 * 8.0);
+  EXPECT_EQ(stats["hierarchy"]["mode"], "uniform");
+}
+
+}  // namespace
+}  // namespace strata::cli_test
