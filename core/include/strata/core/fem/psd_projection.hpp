@@ -2,6 +2,8 @@
 /// \file psd_projection.hpp
 /// Projection of a symmetric matrix onto the positive semi-definite cone (negative eigenvalues
 /// clamped to zero), used to keep Newton's linear systems solvable in implicit solves.
+/// Generic (any symmetric matrix, by eigen-decomposition). The element stiffness projects ∂²ψ/∂F²
+/// in closed form instead (d2psi_dF2_psd in isotropic_hessian.hpp, tested against this).
 #include "strata/core/common/types.hpp"
 
 namespace strata {
