@@ -202,8 +202,9 @@ TEST_P(ElasticModelTest, PatchTestLinearFieldGivesConstantStrainAndNoInteriorFor
   for (Index v = 0; v < model.num_vertices(); ++v) {
     const auto p = mesh.vertices.row(v);
     const bool interior = (p.array() > 1e-12).all() && (p.array() < 1 - 1e-12).all();
-    if (interior)
+    if (interior) {
       EXPECT_LT(f.segment<3>(3 * v).norm(), 1e-10 * max_boundary_force) << "vertex " << v;
+    }
   }
 }
 
