@@ -149,7 +149,7 @@ void AdaptiveSimulation::rebuild(long first_step) {
   SimulationOptions options;
   options.vertex_embedding = constraints.matrix();
   options.dof_vertices = constraints.free_vertices();
-  options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads);
+  options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads, &m_load_traction);
   options.first_step = first_step;
   m_mesh_external = options.extra_mesh_forces;
   m_simulation =
@@ -182,8 +182,9 @@ bool AdaptiveSimulation::adapt(int pass) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
   const TetFields fields = sim.model().tet_fields(sim.positions());
-  const CutState state{*m_tree,           flat,       sim.positions(), fields, m_mesh_external,
-                       sim.vertex_mass(), m_material, sim.step_count()};
+  const CutState state{
+      *m_tree,           flat,       sim.positions(),  fields,          m_mesh_external,
+      sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
   CutChanges changes = m_controller->decide(state, *m_cut);
   // Keep Dirichlet groups exact: never coarsen into a parent on which one would not be.
   std::erase_if(changes.coarsen, [&](NodeId parent) {

@@ -190,10 +190,11 @@ std::vector<PointLoad> finest_level_loads(const TetTree& tree, const std::vector
     for (double area : areas)
       area_sum += area;
     if (!triangles.empty() && area_sum > 0.0) {
+      const double traction = load.total_force.norm() / area_sum;
       for (size_t k = 0; k < triangles.size(); ++k) {
         const Vector3d share = load.total_force * (areas[k] / area_sum / 3.0);
         for (int c = 0; c < 3; ++c)
-          result.push_back({{triangles[k].root, triangles[k].corner[c]}, share});
+          result.push_back({{triangles[k].root, triangles[k].corner[c]}, share, traction});
       }
       continue;
     }
@@ -201,18 +202,29 @@ std::vector<PointLoad> finest_level_loads(const TetTree& tree, const std::vector
     if (points.empty()) throw InputError(load.name + ": region selects no vertex");
     const Vector3d share = load.total_force / static_cast<double>(points.size());
     for (const RootPoint& point : points)
-      result.push_back({point, share});
+      result.push_back({point, share, 0.0});
   }
   return result;
 }
 
 VectorXd map_point_loads(const ActiveCut& cut, const FlatTreeMesh& flat,
-                         const std::vector<PointLoad>& loads) {
+                         const std::vector<PointLoad>& loads, VectorXd* tet_traction) {
   VectorXd forces = VectorXd::Zero(3 * flat.mesh.vertices.rows());
+  std::vector<int> tet_of_node;
+  if (tet_traction) {
+    tet_traction->setZero(static_cast<Index>(flat.tet_nodes.size()));
+    tet_of_node.assign(cut.tree().pool_size(), -1);
+    for (size_t t = 0; t < flat.tet_nodes.size(); ++t)
+      tet_of_node[flat.tet_nodes[t]] = static_cast<int>(t);
+  }
   for (const PointLoad& load : loads) {
     const CutPointWeights w = embed_point(cut, flat, load.point);
     for (int k = 0; k < 4; ++k)
       forces.segment<3>(3 * w.vertices[k]) += w.weights[k] * load.force;
+    if (tet_traction) {
+      double& traction = (*tet_traction)[tet_of_node[w.node]];
+      traction = std::max(traction, load.traction);
+    }
   }
   return forces;
 }

@@ -164,6 +164,7 @@ class AdaptiveSimulation {
   std::vector<PointLoad> m_point_loads;
   std::unique_ptr<ConstrainedCut> m_constrained;
   VectorXd m_mesh_external;  ///< 3·#V of the current cut: gravity + mapped point loads
+  VectorXd m_load_traction;  ///< #T of the current cut: largest finest-level load traction
   std::unique_ptr<Simulation> m_simulation;
 
   std::vector<CutChangeRecord> m_changes;

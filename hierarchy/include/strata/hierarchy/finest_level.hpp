@@ -43,6 +43,9 @@ struct RootPoint {
 struct PointLoad {
   RootPoint point;
   Vector3d force = Vector3d::Zero();
+  /// Magnitude of the traction the load spreads [Pa] (|total force| / loaded finest area); 0 for a
+  /// load split over lattice points (no loaded surface).
+  double traction = 0.0;
 };
 
 /// A point on a flattened cut: x(p) = Σ_k weights[k] · x[vertices[k]] (flat mesh vertices).
@@ -68,9 +71,11 @@ std::vector<CutPointWeights> embed_points(const ActiveCut& cut, const FlatTreeMe
 std::vector<PointLoad> finest_level_loads(const TetTree& tree, const std::vector<RegionLoad>& loads,
                                           double tolerance);
 
-/// The point loads carried onto the flat vertices of `cut`: 3·#V [N] (total force kept).
+/// The point loads carried onto the flat vertices of `cut`: 3·#V [N] (total force kept). With
+/// `tet_traction`, also per flat tet (#T, in flat.tet_nodes order) the largest `traction` of the
+/// loads embedded in it (0 where none acts).
 VectorXd map_point_loads(const ActiveCut& cut, const FlatTreeMesh& flat,
-                         const std::vector<PointLoad>& loads);
+                         const std::vector<PointLoad>& loads, VectorXd* tet_traction = nullptr);
 
 /// Whether every Dirichlet group is exact on node `n` (see the file comment): for each finest
 /// lattice point of `n` that a group selects, all corners of `n` with λ > 0 are selected by it.
