@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "strata/app/mesh_command.hpp"
 #include "strata/app/progress_bar.hpp"
 #include "strata/app/scene_parser.hpp"
 #include "strata/app/scene_runner.hpp"
@@ -26,11 +27,20 @@ int fail(const std::string& message, int code) {
 
 /// `strata info`: counts, volume and quality of a mesh file, or of a scene's mesh.
 int run_info(const std::filesystem::path& path) {
+  if (strata::app::is_surface_file(path)) {
+    strata::app::print_surface_info(path, std::cout);
+    return kExitOk;
+  }
   strata::TetMesh mesh;
   std::string source = path.string();
   if (path.extension() == ".json") {
     const strata::app::Scene scene = strata::app::load_scene(path, {});
     strata::app::PreparedMesh prepared = strata::app::prepare_scene_mesh(scene);
+    if (prepared.meshing) {
+      std::cout << path.string() << " (mesh generated from " << prepared.source << ")\n"
+                << strata::format_meshing_report(*prepared.meshing) << std::flush;
+      return kExitOk;
+    }
     mesh = std::move(prepared.mesh);
     source += " (mesh " + prepared.source + ")";
   } else {
@@ -77,6 +87,29 @@ int main(int argc, char** argv) {
   info->add_option("mesh", info_file, "Mesh file (.msh, .mesh, .node/.ele, .vtu) or scene (.json)")
       ->required();
 
+  strata::app::MeshCommand mesh_command;
+  CLI::App* mesh = app.add_subcommand("mesh", "Tetrahedralise a surface (.off, .obj, .ply, .stl)");
+  mesh->add_option("input", mesh_command.input, "Surface file")->required();
+  mesh->add_option("--out", mesh_command.output, "Tet mesh file (.vtu, .mesh, .msh, .node)")
+      ->required();
+  strata::MeshingOptions& meshing = mesh_command.options;
+  mesh->add_option("--cell-size", meshing.cell_size, "Max tet circumradius")->required();
+  mesh->add_option("--facet-size", meshing.facet_size,
+                   "Max surface facet circumradius (default: cell size)");
+  mesh->add_option("--facet-distance", meshing.facet_distance,
+                   "Max facet-to-surface distance (default: cell size / 10)");
+  mesh->add_option("--facet-angle", meshing.facet_angle, "Min facet angle [deg], <= 30")
+      ->capture_default_str();
+  mesh->add_option("--radius-edge", meshing.cell_radius_edge_ratio,
+                   "Max tet radius-edge ratio, >= 2")
+      ->capture_default_str();
+  mesh->add_flag("--sharp-features", meshing.sharp_features, "Protect sharp edges of the surface");
+  mesh->add_flag("!--no-optimize", meshing.perturb, "Skip sliver perturbation and exudation");
+  mesh->add_flag("--odt", meshing.odt, "ODT smoothing");
+  mesh->add_flag("--lloyd", meshing.lloyd, "Lloyd smoothing");
+  mesh->add_option("--seed", meshing.seed, "Random seed")->capture_default_str();
+  mesh->add_flag("-q,--quiet", mesh_command.quiet, "No report");
+
   CLI::App* convert = app.add_subcommand("convert", "Convert a tet mesh between file formats");
   std::string convert_in, convert_out;
   convert->add_option("input", convert_in, "Input mesh file")->required();
@@ -105,6 +138,9 @@ int main(int argc, char** argv) {
       strata::app::run_scene(scene, options);
     } else if (*info) {
       return run_info(info_file);
+    } else if (*mesh) {
+      mesh_command.options.exude = mesh_command.options.perturb;
+      strata::app::run_mesh_command(mesh_command, std::cout, std::cerr);
     } else if (*convert) {
       strata::convert_tet_mesh(convert_in, convert_out);
       std::cout << "strata: wrote " << convert_out << std::endl;

@@ -1,6 +1,9 @@
+#include <iostream>
+
 #include "strata/app/scene_runner.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
+#include "strata/meshing/mesh_surface_file.hpp"
 
 namespace strata::app {
 
@@ -9,8 +12,13 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
   PreparedMesh prepared;
   try {
     if (scene.mesh.surface) {
-      throw InputError(scene.mesh.surface->string() +
-                       ": tetrahedralising a surface is not available yet");
+      const MeshCache cache(mesh_cache_dir(scene));
+      SurfaceMeshingResult result =
+          mesh_surface_file(*scene.mesh.surface, scene.mesh.meshing, &cache);
+      if (!result.warning.empty()) std::cerr << "strata: warning: " << result.warning << std::endl;
+      prepared.source = scene.mesh.surface->string();
+      prepared.mesh = std::move(result.mesh);
+      prepared.meshing = result.report;
     } else if (scene.mesh.file) {
       prepared.source = scene.mesh.file->string();
       prepared.mesh = read_tet_mesh(*scene.mesh.file);
@@ -26,6 +34,10 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
   prepared.removed_vertices = remove_unreferenced_vertices(prepared.mesh);
   prepared.reoriented_tets = orient_tets(prepared.mesh);
   return prepared;
+}
+
+std::filesystem::path mesh_cache_dir(const Scene& scene) {
+  return scene.file.parent_path() / "out" / "mesh_cache";
 }
 
 std::filesystem::path default_output_dir(const Scene& scene) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "strata/app/fine_surface.hpp"
+#include "strata/app/mesh_command.hpp"
 #include "strata/app/progress_bar.hpp"
 #include "strata/app/run_outputs.hpp"
 #include "strata/app/vtk_series.hpp"
@@ -152,6 +153,7 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   stats["mesh_source"] = prepared.source;
   stats["reoriented_tets"] = prepared.reoriented_tets;
   stats["removed_vertices"] = prepared.removed_vertices;
+  if (prepared.meshing) stats["meshing"] = meshing_stats_json(*prepared.meshing);
   stats["material"] = {{"model", to_string(scene.material.model)},
                        {"youngs_modulus", scene.material.youngs_modulus},
                        {"poisson_ratio", scene.material.poisson_ratio},

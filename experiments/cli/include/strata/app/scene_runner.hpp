@@ -5,10 +5,12 @@
 /// reactions.csv, the VTK series and stats.json into the output folder.
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
 
 #include "strata/app/scene.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/meshing/meshing_report.hpp"
 
 namespace strata::app {
 
@@ -18,10 +20,14 @@ struct PreparedMesh {
   std::string source;          ///< the mesh file or "box"
   Index removed_vertices = 0;  ///< vertices no tet referenced
   Index reoriented_tets = 0;   ///< tets flipped to positive orientation
+  /// Set when the mesh was generated from "mesh": {"surface": ...} (or taken from the cache).
+  std::optional<MeshingReport> meshing;
 };
 
-/// Reads (or builds) and prepares the scene's mesh. InputErrors name the scene file and key
-/// ("scene.json: mesh.file: <reader message naming the mesh file>").
+/// Reads (or builds, or generates from a surface) and prepares the scene's mesh. InputErrors name
+/// the scene file and key ("scene.json: mesh.file: <reader message naming the mesh file>").
+/// Generated meshes are cached in mesh_cache_dir(scene); a non-watertight surface prints a
+/// warning to std::cerr.
 PreparedMesh prepare_scene_mesh(const Scene& scene);
 
 struct RunOptions {
@@ -40,6 +46,9 @@ struct RunSummary {
   double stable_dt_estimate = 0.0;
   std::filesystem::path output_dir;
 };
+
+/// `<scene folder>/out/mesh_cache`: generated meshes, keyed by surface content and parameters.
+std::filesystem::path mesh_cache_dir(const Scene& scene);
 
 /// `<scene folder>/out/<scene stem>`.
 std::filesystem::path default_output_dir(const Scene& scene);
