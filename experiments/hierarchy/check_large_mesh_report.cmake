@@ -1,0 +1,38 @@
+# Runs `${EXAMPLE} --quick --out ${OUT}` and checks the JSON report: every key is present, the
+# per-step records are complete, and the tree holds less memory than the full tree would (no
+# timing is checked).
+execute_process(COMMAND ${EXAMPLE} --quick --out ${OUT} RESULT_VARIABLE status)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "strata_large_mesh_example --quick exited with ${status}")
+endif()
+file(READ ${OUT} report)
+foreach(key coarse_tets levels potential_leaves full_tree_memory_bytes_lower_bound
+            tree_memory_bytes max_tree_memory_bytes peak_memory_bytes active_tets dofs
+            active_level_counts median_step_seconds bookkeeping_seconds stepping_seconds
+            bookkeeping_fraction steps)
+  string(JSON value ERROR_VARIABLE error GET "${report}" ${key})
+  if(error)
+    message(FATAL_ERROR "report ${OUT}: missing key ${key}")
+  endif()
+endforeach()
+string(JSON num_steps LENGTH "${report}" steps)
+if(num_steps LESS 1)
+  message(FATAL_ERROR "report ${OUT}: no steps recorded")
+endif()
+math(EXPR last "${num_steps} - 1")
+foreach(key step time active_tets dofs seconds tree_memory_bytes rss_bytes)
+  string(JSON value ERROR_VARIABLE error GET "${report}" steps ${last} ${key})
+  if(error)
+    message(FATAL_ERROR "report ${OUT}: steps[${last}] has no ${key}")
+  endif()
+endforeach()
+string(JSON tree GET "${report}" max_tree_memory_bytes)
+string(JSON full GET "${report}" full_tree_memory_bytes_lower_bound)
+string(JSON active GET "${report}" active_tets)
+string(JSON leaves GET "${report}" potential_leaves)
+if(active LESS 1 OR active GREATER_EQUAL leaves)
+  message(FATAL_ERROR "report ${OUT}: ${active} active tets of ${leaves} potential leaves")
+endif()
+if(tree GREATER_EQUAL full)
+  message(FATAL_ERROR "report ${OUT}: tree ${tree} B is not below the full tree's ${full} B")
+endif()
