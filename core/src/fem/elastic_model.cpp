@@ -91,14 +91,18 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
     Dm_inv = m_rest.Dm_inv[t];
     m_sorted_volume[i] = m_rest.rest_volume[t];
   }
-  // Dm⁻¹ regrouped for the vectorised kernels: lane group g holds entry (j, c) of its kLanes tets
-  // at [g · 9 · kLanes + (3c + j) · kLanes + lane].
+  // Rest data regrouped for the vectorised kernels, one contiguous block per lane group g: entry
+  // (j, c) of Dm⁻¹ of its kLanes tets at [g · kLaneRest + (3c + j) · kLanes + lane], then the rest
+  // volumes at [g · kLaneRest + 9 · kLanes + lane].
+  static_assert(kLaneRest == 10 * detail::kLanes);
   const Index num_groups = (num_tets + detail::kLanes - 1) / detail::kLanes;
-  m_lane_Dm_inv.assign(9 * detail::kLanes * num_groups, 0.0);
-  for (Index i = 0; i < num_tets; ++i)
+  m_lane_rest.assign(kLaneRest * num_groups, 0.0);
+  for (Index i = 0; i < num_tets; ++i) {
+    double* group = &m_lane_rest[kLaneRest * (i / detail::kLanes)];
     for (int entry = 0; entry < 9; ++entry)
-      m_lane_Dm_inv[9 * detail::kLanes * (i / detail::kLanes) + entry * detail::kLanes +
-                    i % detail::kLanes] = m_sorted_Dm_inv[9 * i + entry];
+      group[entry * detail::kLanes + i % detail::kLanes] = m_sorted_Dm_inv[9 * i + entry];
+    group[9 * detail::kLanes + i % detail::kLanes] = m_sorted_volume[i];
+  }
   build_stiffness_pattern();
 }
 
@@ -175,13 +179,14 @@ void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x,
       const typename Kernel::LaneKernel lanes(m_lame);
       for (; i + detail::kLanes <= end; i += detail::kLanes) {
         const int group = i / detail::kLanes;
-        const double* lane_Dm_inv = &m_lane_Dm_inv[9 * detail::kLanes * group];
+        const double* lane_Dm_inv = &m_lane_rest[kLaneRest * group];
+        const double* lane_volume = lane_Dm_inv + 9 * detail::kLanes;
         if (i + kPrefetchTets + detail::kLanes <= end)
           prefetch_vertices(&m_sorted_tets[4 * (i + kPrefetchTets)], positions, forces);
         sum += energy ? lane_group_forces<true>(lanes, positions, &m_sorted_tets[4 * i],
-                                                lane_Dm_inv, &m_sorted_volume[i], forces)
+                                                lane_Dm_inv, lane_volume, forces)
                       : lane_group_forces<false>(lanes, positions, &m_sorted_tets[4 * i],
-                                                 lane_Dm_inv, &m_sorted_volume[i], forces);
+                                                 lane_Dm_inv, lane_volume, forces);
       }
     }
     for (; i < end; ++i)
@@ -361,14 +366,14 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
       const detail::StvkStiffnessLanes lanes(m_lame);
       double lane_K[kLanes][12][12];
       for (; i + kLanes <= end; i += kLanes) {
-        const double* lane_Dm_inv = &m_lane_Dm_inv[9 * kLanes * (i / kLanes)];
+        const double* lane_Dm_inv = &m_lane_rest[kLaneRest * (i / kLanes)];
         // The value array is far larger than the caches: fetch the next group's entries while
         // this group's blocks are computed.
         if (i + 2 * kLanes <= end)
           detail::prefetch_block_entries(&m_block_offsets[48 * (i + kLanes)], values);
         double F[3][3][kLanes];
         detail::lane_deformation_gradient(x.data(), &m_sorted_tets[4 * i], lane_Dm_inv, F);
-        lanes(F, lane_Dm_inv, &m_sorted_volume[i], lane_K);
+        lanes(F, lane_Dm_inv, lane_Dm_inv + 9 * kLanes, lane_K);
         for (int l = 0; l < kLanes; ++l)
           detail::scatter_element_stiffness(lane_K[l], &m_block_offsets[48 * (i + l)], values);
       }

@@ -75,7 +75,9 @@ class ElasticModel {
   std::vector<int> m_sorted_tets;       ///< 4 per tet
   std::vector<double> m_sorted_Dm_inv;  ///< 9 per tet, column-major
   std::vector<double> m_sorted_volume;  ///< 1 per tet
-  std::vector<double> m_lane_Dm_inv;    ///< Dm⁻¹ in lane groups for the vectorised kernels
+  /// Dm⁻¹ and rest volume in lane groups for the vectorised kernels, kLaneRest per group.
+  static constexpr int kLaneRest = 40;
+  std::vector<double> m_lane_rest;
   SparseMatrixd m_pattern;
   /// For sorted tet i, vertex pair (a, b) and column c: offset in K's value array of the entry
   /// (3·v_a, 3·v_b + c); rows 3·v_a + 1 and 3·v_a + 2 follow it. 48 per tet.
