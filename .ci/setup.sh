@@ -44,8 +44,12 @@ else
 fi
 
 start=$(date +%s.%N)
+# Configuring also extracts the CGAL test models (libcgal-demo) into <build>/data/models/: run it
+# again when they are missing (e.g. the package was installed after the first configure).
 if [[ ! -f "${build_dir}/CMakeCache.txt" ]]; then
   cmake -S "${repo_root}" -B "${build_dir}" -DCMAKE_BUILD_TYPE=Release
+elif [[ ! -f "${build_dir}/data/models/armadillo.off" ]]; then
+  cmake -S "${repo_root}" -B "${build_dir}"
 fi
 cmake --build "${build_dir}" -j "${jobs}"
 end=$(date +%s.%N)
