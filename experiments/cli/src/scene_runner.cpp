@@ -18,8 +18,8 @@
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
-#include "strata/meshing/surface_io.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
+#include "strata/meshing/surface_io.hpp"
 
 namespace strata::app {
 namespace {
@@ -277,6 +277,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
           << " outside the mesh, at most " << surface->max_outside_distance() << " m)\n";
     }
   }
+  std::vector<RootPoint> surface_roots;  // the surface's vertices as material points of the tree
+  if (surface && scene_simulation.adaptive()) {
+    const SurfaceBinding& binding = surface->binding();
+    for (Index i = 0; i < binding.tets.size(); ++i)
+      surface_roots.push_back({binding.tets[i], surface->rest().vertices.row(i).transpose()});
+  }
 
   const auto write_frame = [&]() {
     simulation = &scene_simulation.current();  // a hierarchy rebuilds it when the cut changes
@@ -292,8 +298,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
       const VectorXi levels = adaptive ? adaptive->cell_levels() : VectorXi();
       vtk->write_frame(time, *simulation, adaptive ? &levels : nullptr);
     }
-    if (vtk && surface && surface->matches(simulation->mesh())) {
-      const MatrixX3d surface_positions = surface->positions(simulation->positions());
+    if (vtk && surface && (adaptive || surface->matches(simulation->mesh()))) {
+      // On a hierarchy the surface follows the active cut: each vertex is interpolated in the
+      // active ancestor of the leaf holding it (bound once to the coarse mesh = the tree's roots).
+      const MatrixX3d surface_positions =
+          adaptive ? MatrixX3d(surface->rest().vertices + adaptive->displacements(surface_roots))
+                   : surface->positions(simulation->positions());
       vtk->write_surface_frame(time, surface_positions, surface->rest().triangles,
                                surface->fields(surface_positions));
     }
