@@ -37,6 +37,16 @@ std::unique_ptr<RefinementIndicator> make_indicator(const HierarchySettings& set
   return std::make_unique<ForceIndicator>(settings.criteria.stress_floor);
 }
 
+/// Σ m_q v_q over the DOF vertices [kg·m/s].
+Vector3d momentum(const Simulation& simulation) {
+  const VectorXd& mass = simulation.dof_vertex_mass();
+  const VectorXd& v = simulation.dof_velocities();
+  Vector3d p = Vector3d::Zero();
+  for (Index q = 0; q < mass.size(); ++q)
+    p += mass[q] * v.segment<3>(3 * q);
+  return p;
+}
+
 SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.steps += b.steps;
   a.newton_iterations += b.newton_iterations;
@@ -201,6 +211,7 @@ bool AdaptiveSimulation::adapt(int pass) {
   record.time = sim.time();
   record.tets_before = m_cut->size();
   record.energy_before = sim.kinetic_energy() + sim.elastic_energy();
+  record.momentum_before = momentum(sim);
   const VectorXd old_positions = sim.positions();
   const VectorXd old_velocities = sim.velocities();
   const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
@@ -227,6 +238,7 @@ bool AdaptiveSimulation::adapt(int pass) {
   record.tets_after = m_cut->size();
   record.dofs_after = m_simulation->embedded_model().num_dofs();
   record.energy_after = m_simulation->kinetic_energy() + m_simulation->elastic_energy();
+  record.momentum_after = momentum(*m_simulation);
   record.seconds = seconds_since(start);
   m_bookkeeping_seconds += record.seconds;
   m_changes.push_back(record);

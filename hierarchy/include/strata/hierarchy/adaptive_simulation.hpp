@@ -80,6 +80,8 @@ struct CutChangeRecord {
   Index dofs_after = 0;                   ///< 3·#free vertices after the change
   double energy_before = 0.0;             ///< kinetic + elastic energy just before the change [J]
   double energy_after = 0.0;              ///< … just after (state transferred) [J]
+  Vector3d momentum_before = Vector3d::Zero();  ///< Σ m_q v_q just before the change [kg·m/s]
+  Vector3d momentum_after = Vector3d::Zero();   ///< … just after
   double seconds = 0.0;  ///< wall time of the change (decide, edit, flatten, rebuild)
 };
 
