@@ -36,7 +36,7 @@ using Clock = std::chrono::steady_clock;
 struct Options {
   std::array<int, 3> cells = {20, 20, 21};
   int levels = 3;
-  int steps = 10;
+  int steps = 7;
   int adapt_every = 2;
   double dt = 5e-3;
   double threshold = 3.0;
