@@ -5,7 +5,7 @@
 //
 // It prints, and writes as JSON to --out, the peak resident memory (VmHWM of /proc/self/status),
 // the tree's memory_bytes against a lower bound for the full level-L tree, the active tets and
-// DOFs after every step, the wall time per step, and the time spent in cut changes
+// DOFs after every step, the wall and CPU time per step, and the time spent in cut changes
 // (bookkeeping). `--quick` runs a tiny case (a smoke test, a second or so).
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
