@@ -13,6 +13,7 @@
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
 #include "strata/core/mesh/mesh_quality.hpp"
+#include "strata/meshing/mesh_level_set.hpp"
 
 namespace {
 
@@ -26,7 +27,13 @@ int fail(const std::string& message, int code) {
 }
 
 /// `strata info`: counts, volume and quality of a mesh file, or of a scene's mesh.
-int run_info(const std::filesystem::path& path) {
+int run_info(const std::filesystem::path& path, const std::string& grid) {
+  if (strata::is_vdb_file(path)) {
+    strata::app::print_level_set_info(path, grid, std::cout);
+    return kExitOk;
+  }
+  if (!grid.empty())
+    throw strata::InputError(path.string() + ": --grid applies to .vdb files only");
   if (strata::app::is_surface_file(path)) {
     strata::app::print_surface_info(path, std::cout);
     return kExitOk;
@@ -84,12 +91,18 @@ int main(int argc, char** argv) {
 
   CLI::App* info = app.add_subcommand("info", "Print counts, volume and quality of a tet mesh");
   std::string info_file;
-  info->add_option("mesh", info_file, "Mesh file (.msh, .mesh, .node/.ele, .vtu) or scene (.json)")
+  std::string info_grid;
+  info->add_option("mesh", info_file,
+                   "Mesh file (.msh, .mesh, .node/.ele, .vtu), surface, level set (.vdb) or "
+                   "scene (.json)")
       ->required();
+  info->add_option("--grid", info_grid, "Grid of a .vdb (default: its first float grid)");
 
   strata::app::MeshCommand mesh_command;
-  CLI::App* mesh = app.add_subcommand("mesh", "Tetrahedralise a surface (.off, .obj, .ply, .stl)");
-  mesh->add_option("input", mesh_command.input, "Surface file")->required();
+  CLI::App* mesh = app.add_subcommand(
+      "mesh", "Tetrahedralise a surface (.off, .obj, .ply, .stl) or a level set (.vdb)");
+  mesh->add_option("input", mesh_command.input, "Surface or level-set file")->required();
+  mesh->add_option("--grid", mesh_command.grid, "Grid of a .vdb (default: its first float grid)");
   mesh->add_option("--out", mesh_command.output, "Tet mesh file (.vtu, .mesh, .msh, .node)")
       ->required();
   strata::MeshingOptions& meshing = mesh_command.options;
@@ -137,7 +150,7 @@ int main(int argc, char** argv) {
       options.progress = !quiet && strata::app::stderr_is_terminal();
       strata::app::run_scene(scene, options);
     } else if (*info) {
-      return run_info(info_file);
+      return run_info(info_file, info_grid);
     } else if (*mesh) {
       mesh_command.options.exude = mesh_command.options.perturb;
       strata::app::run_mesh_command(mesh_command, std::cout, std::cerr);

@@ -29,6 +29,11 @@ std::string meshing_cache_key(const std::filesystem::path& input, const MeshingO
   std::ostringstream content;
   content << in.rdbuf();
   if (!in) throw InputError(input.string() + ": cannot read");
+  return meshing_cache_key_of_bytes(content.str(), options, route);
+}
+
+std::string meshing_cache_key_of_bytes(const std::string& bytes, const MeshingOptions& options,
+                                       const std::string& route) {
   std::ostringstream parameters;
   parameters.precision(17);
   parameters << kCacheFormat << '|' << route << '|' << options.cell_size << '|'
@@ -37,7 +42,7 @@ std::string meshing_cache_key(const std::filesystem::path& input, const MeshingO
              << options.feature_angle << '|' << options.odt << '|' << options.lloyd << '|'
              << options.perturb << '|' << options.exude << '|' << options.sliver_bound << '|'
              << options.seed;
-  const std::uint64_t hash = fnv1a_64(parameters.str(), fnv1a_64(content.str()));
+  const std::uint64_t hash = fnv1a_64(parameters.str(), fnv1a_64(bytes));
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
   return hex;

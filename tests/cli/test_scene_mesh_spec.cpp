@@ -87,12 +87,16 @@ TEST(SceneMeshSpec, ErrorsNameTheKey) {
             "below 2)");
   EXPECT_EQ(parse_error(surface_scene({{"surface", "a.off"}, {"cell_size", 1}, {"seed", -1}})),
             "dir/scene.json: mesh.seed: must be >= 0");
-  EXPECT_EQ(parse_error(surface_scene({{"surface", "a.off"}, {"file", "b.msh"}})),
-            "dir/scene.json: mesh: surface excludes file and box");
-  EXPECT_EQ(parse_error(surface_scene(json::object())),
-            "dir/scene.json: mesh: must have one of file, box, surface");
-  EXPECT_EQ(parse_error(surface_scene({{"file", "b.msh"}, {"cell_size", 1}})),
-            "dir/scene.json: mesh.cell_size: is a meshing key: only allowed with surface");
+  EXPECT_EQ(
+      parse_error(surface_scene({{"surface", "a.off"}, {"file", "b.msh"}})),
+      "dir/scene.json: mesh: must have exactly one of file, box, surface, level_set, implicit");
+  EXPECT_EQ(
+      parse_error(surface_scene(json::object())),
+      "dir/scene.json: mesh: must have exactly one of file, box, surface, level_set, implicit");
+  EXPECT_EQ(
+      parse_error(surface_scene({{"file", "b.msh"}, {"cell_size", 1}})),
+      "dir/scene.json: mesh.cell_size: is a meshing key: only allowed with surface, level_set, "
+      "implicit");
   EXPECT_EQ(parse_error(surface_scene({{"surface", "a.off"}, {"cell_size", 1}, {"cells", 1}})),
             "dir/scene.json: mesh.cells: unknown key");
 }

@@ -196,7 +196,8 @@ TEST(SceneParser, UnknownEnumValuesListTheChoices) {
 TEST(SceneParser, ExclusiveAlternatives) {
   json scene = minimal_scene();
   scene["mesh"]["file"] = "a.msh";
-  EXPECT_EQ(parse_error(scene), "scene.json: mesh: must have exactly one of file, box");
+  EXPECT_EQ(parse_error(scene),
+            "scene.json: mesh: must have exactly one of file, box, surface, level_set, implicit");
   scene = minimal_scene();
   scene["prescribed"] =
       json::parse(R"([{"region": {"sphere": {"center": [0,0,0], "radius": 1}}}])");

@@ -5,7 +5,9 @@
 #include <ostream>
 #include <string>
 
+#include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
+#include "strata/meshing/mesh_level_set.hpp"
 #include "strata/meshing/mesh_surface_file.hpp"
 #include "strata/meshing/surface_io.hpp"
 
@@ -13,12 +15,26 @@ namespace strata::app {
 
 void run_mesh_command(const MeshCommand& command, std::ostream& log, std::ostream& warnings) {
   mesh_format_of(command.output);  // refuse an unknown output format before meshing
-  const SurfaceMeshingResult result = mesh_surface_file(command.input, command.options);
-  if (!result.warning.empty()) warnings << "strata: warning: " << result.warning << std::endl;
-  write_tet_mesh(command.output, result.mesh);
+  TetMesh mesh;
+  MeshingReport report;
+  if (is_vdb_file(command.input)) {
+    LevelSetMeshingResult result =
+        mesh_level_set_file(command.input, command.grid, command.options);
+    mesh = std::move(result.mesh);
+    report = result.report;
+  } else {
+    if (!command.grid.empty()) {
+      throw InputError(command.input.string() + ": --grid applies to .vdb input only");
+    }
+    SurfaceMeshingResult result = mesh_surface_file(command.input, command.options);
+    if (!result.warning.empty()) warnings << "strata: warning: " << result.warning << std::endl;
+    mesh = std::move(result.mesh);
+    report = result.report;
+  }
+  write_tet_mesh(command.output, mesh);
   if (!command.quiet) {
     log << command.input.string() << " -> " << command.output.string() << "\n"
-        << format_meshing_report(result.report) << std::flush;
+        << format_meshing_report(report) << std::flush;
   }
 }
 
@@ -33,6 +49,12 @@ void print_surface_info(const std::filesystem::path& path, std::ostream& out) {
   const SurfaceMesh surface = read_surface(path);
   out << path.string() << " (surface)\n"
       << format_surface_report(describe_surface(surface)) << std::flush;
+}
+
+void print_level_set_info(const std::filesystem::path& path, const std::string& grid,
+                          std::ostream& out) {
+  const LevelSet level_set = LevelSet::read_vdb(path, grid);
+  out << path.string() << " (level set)\n" << format_level_set_report(level_set) << std::flush;
 }
 
 nlohmann::json meshing_stats_json(const MeshingReport& report) {

@@ -3,6 +3,7 @@
 #include "strata/app/scene_runner.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
+#include "strata/meshing/mesh_level_set.hpp"
 #include "strata/meshing/mesh_surface_file.hpp"
 
 namespace strata::app {
@@ -11,12 +12,21 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
   const std::string where = scene.file.string() + ": mesh";
   PreparedMesh prepared;
   try {
+    const MeshCache cache(mesh_cache_dir(scene));
     if (scene.mesh.surface) {
-      const MeshCache cache(mesh_cache_dir(scene));
       SurfaceMeshingResult result =
           mesh_surface_file(*scene.mesh.surface, scene.mesh.meshing, &cache);
       if (!result.warning.empty()) std::cerr << "strata: warning: " << result.warning << std::endl;
       prepared.source = scene.mesh.surface->string();
+      prepared.mesh = std::move(result.mesh);
+      prepared.meshing = result.report;
+    } else if (scene.mesh.level_set || scene.mesh.implicit) {
+      LevelSetMeshingResult result =
+          scene.mesh.level_set ? mesh_level_set_file(*scene.mesh.level_set, scene.mesh.grid,
+                                                     scene.mesh.meshing, &cache)
+                               : mesh_implicit_shape(*scene.mesh.implicit, scene.mesh.voxel_size,
+                                                     scene.mesh.meshing, &cache);
+      prepared.source = scene.mesh.level_set ? scene.mesh.level_set->string() : "implicit";
       prepared.mesh = std::move(result.mesh);
       prepared.meshing = result.report;
     } else if (scene.mesh.file) {
@@ -28,7 +38,11 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
     }
     validate_tet_mesh(prepared.mesh, prepared.source);
   } catch (const InputError& error) {
-    const char* key = scene.mesh.surface ? ".surface: " : scene.mesh.file ? ".file: " : ".box: ";
+    const char* key = scene.mesh.surface     ? ".surface: "
+                      : scene.mesh.level_set ? ".level_set: "
+                      : scene.mesh.implicit  ? ".implicit: "
+                      : scene.mesh.file      ? ".file: "
+                                             : ".box: ";
     throw InputError(where + key + error.what());
   }
   prepared.removed_vertices = remove_unreferenced_vertices(prepared.mesh);

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "scene_hierarchy.hpp"
+#include "scene_implicit.hpp"
 #include "scene_json.hpp"
 #include "strata/app/scene_overrides.hpp"
 
@@ -79,26 +80,38 @@ MeshingOptions parse_meshing_options(const SceneValue& value) {
 }
 
 MeshSpec parse_mesh(const SceneValue& value, const std::filesystem::path& folder) {
-  value.expect_object({"file", "box", "surface", "cell_size", "facet_size", "facet_distance",
-                       "facet_angle", "radius_edge_ratio", "sharp_features", "perturb", "exude",
-                       "odt", "lloyd", "seed"});
-  if (!value.has("file") && !value.has("box") && !value.has("surface")) {
-    value.fail("must have one of file, box, surface");
+  value.expect_object({"file", "box", "surface", "level_set", "grid", "implicit", "voxel_size",
+                       "cell_size", "facet_size", "facet_distance", "facet_angle",
+                       "radius_edge_ratio", "sharp_features", "perturb", "exude", "odt", "lloyd",
+                       "seed"});
+  const int sources = value.has("file") + value.has("box") + value.has("surface") +
+                      value.has("level_set") + value.has("implicit");
+  if (sources != 1) value.fail("must have exactly one of file, box, surface, level_set, implicit");
+  if (value.has("grid") && !value.has("level_set")) {
+    value.at("grid").fail("only allowed with level_set");
   }
-  if (value.has("surface") && (value.has("file") || value.has("box"))) {
-    value.fail("surface excludes file and box");
+  if (value.has("voxel_size") && !value.has("implicit")) {
+    value.at("voxel_size").fail("only allowed with implicit");
   }
-  if (value.has("file") && value.has("box")) value.fail("must have exactly one of file, box");
   MeshSpec mesh;
-  if (value.has("surface")) {
-    mesh.surface = parse_path(value.at("surface"), folder);
+  if (value.has("surface") || value.has("level_set") || value.has("implicit")) {
+    if (value.has("surface")) mesh.surface = parse_path(value.at("surface"), folder);
+    if (value.has("level_set")) mesh.level_set = parse_path(value.at("level_set"), folder);
+    if (value.has("grid")) {
+      mesh.grid = value.at("grid").string();
+      if (mesh.grid.empty()) value.at("grid").fail("must not be empty");
+    }
+    if (value.has("implicit")) mesh.implicit = detail::parse_implicit_shape(value.at("implicit"));
+    if (value.has("voxel_size")) mesh.voxel_size = value.at("voxel_size").positive();
     mesh.meshing = parse_meshing_options(value);
     return mesh;
   }
   for (const char* key :
        {"cell_size", "facet_size", "facet_distance", "facet_angle", "radius_edge_ratio",
         "sharp_features", "perturb", "exude", "odt", "lloyd", "seed"}) {
-    if (value.has(key)) value.at(key).fail("is a meshing key: only allowed with surface");
+    if (value.has(key)) {
+      value.at(key).fail("is a meshing key: only allowed with surface, level_set, implicit");
+    }
   }
   if (value.has("file")) {
     mesh.file = parse_path(value.at("file"), folder);

@@ -21,6 +21,11 @@ std::uint64_t fnv1a_64(const std::string& bytes, std::uint64_t hash = 0xcbf29ce4
 std::string meshing_cache_key(const std::filesystem::path& input, const MeshingOptions& options,
                               const std::string& route);
 
+/// Cache key of an input given as bytes (e.g. a canonical description of an implicit shape):
+/// meshing_cache_key(file, ...) equals meshing_cache_key_of_bytes(<the file's bytes>, ...).
+std::string meshing_cache_key_of_bytes(const std::string& bytes, const MeshingOptions& options,
+                                       const std::string& route);
+
 /// Generated meshes in one folder, one file `<key>.vtu` per entry.
 class MeshCache {
  public:

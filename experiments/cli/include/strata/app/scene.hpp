@@ -16,17 +16,26 @@
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
+#include "strata/meshing/implicit_shape.hpp"
 #include "strata/meshing/meshing_options.hpp"
 
 namespace strata::app {
 
-/// "mesh": a tet mesh file, a procedural box, or a surface to tetrahedralise.
+/// "mesh": a tet mesh file, a procedural box, or a solid to tetrahedralise (a surface, a .vdb
+/// level set or an implicit CSG shape); exactly one of file, box, surface, level_set, implicit.
 struct MeshSpec {
   std::optional<std::filesystem::path> file;  ///< absolute, or relative to the working folder
   /// Closed surface (.off, .obj, .ply, .stl) meshed with CGAL Mesh_3 using `meshing`; absolute, or
   /// relative to the working folder.
   std::optional<std::filesystem::path> surface;
-  MeshingOptions meshing;                 ///< used when `surface` is set
+  /// OpenVDB level set (.vdb) whose inside (φ < 0) is meshed using `meshing`; absolute, or
+  /// relative to the working folder.
+  std::optional<std::filesystem::path> level_set;
+  std::string grid;  ///< float grid of `level_set` to mesh; empty: the file's first float grid
+  /// Implicit primitives and CSG meshed through a level set using `meshing`.
+  std::optional<ImplicitShape> implicit;
+  double voxel_size = 0.0;  ///< voxels of `implicit` [m]; 0: implicit_voxel_size(meshing)
+  MeshingOptions meshing;   ///< used with surface, level_set or implicit
   Vector3d box_min = Vector3d::Zero();    ///< used when `file` is empty [m]
   Vector3d box_max = Vector3d::Ones();    ///< [m]
   std::array<int, 3> box_cells{1, 1, 1};  ///< hexahedral cells per axis (6 tets each)
