@@ -32,6 +32,16 @@ TetMesh tetrahedralize_level_set(const LevelSet& level_set, const MeshingOptions
                                  double volume_estimate) {
   const auto [lo, hi] = level_set.bounding_box();
   const Vector3d margin = Vector3d::Constant(kBoxMarginVoxels * level_set.voxel_size());
+  // Mesh_3 needs φ > 0 on the box: an inverted grid (negative outside) would mesh the box itself.
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vector3d p((corner & 1 ? hi : lo).x(), (corner & 2 ? hi : lo).y(),
+                     (corner & 4 ? hi : lo).z());
+    if (!(level_set.signed_distance(p + (p - 0.5 * (lo + hi)).cwiseSign().cwiseProduct(margin)) >
+          0.0)) {
+      throw InputError("level set '" + level_set.name() +
+                       "' is not positive outside its narrow band (an inverted or unbounded grid)");
+    }
+  }
   return tetrahedralize_implicit(
       [&level_set](const Vector3d& p) { return level_set.signed_distance(p); }, lo - margin,
       hi + margin, options, volume_estimate);

@@ -244,6 +244,13 @@ TEST(LevelSetMeshing, RefusedInput) {
                   0.0, options);
             }).find("encloses no volume") != std::string::npos,
             true);
+  // An inverted grid (negative outside) bounds no solid.
+  const LevelSet inverted = level_set_from_function(
+      [](const Vector3d& p) { return 1.0 - p.norm(); }, Vector3d::Constant(-1),
+      Vector3d::Constant(1), level_set_options, "inverted");
+  EXPECT_EQ(error_of([&] { mesh_level_set(inverted, options, "inverted"); }),
+            "level set 'inverted' is not positive outside its narrow band (an inverted or "
+            "unbounded grid)");
   // The tet-count guard uses the level set's volume.
   EXPECT_NE(error_of([&] {
               mesh_implicit_shape(ImplicitShape::sphere(Vector3d::Zero(), 1.0), 0.05,

@@ -33,7 +33,8 @@ double level_set_volume(const LevelSet& level_set);
 
 /// Tetrahedralises { φ < 0 } with Mesh_3's implicit domain (tetrahedralize_implicit) over the
 /// bounding box of the active voxels grown by 2 voxels (φ > 0 on its faces). The tet-count guard
-/// uses `volume_estimate` [m³] (0: the box volume). InputError as tetrahedralize_implicit.
+/// uses `volume_estimate` [m³] (0: the box volume). InputError when φ is not positive at the box's
+/// corners (an inverted or unbounded grid), or as tetrahedralize_implicit.
 TetMesh tetrahedralize_level_set(const LevelSet& level_set, const MeshingOptions& options,
                                  double volume_estimate = 0.0);
 
