@@ -111,6 +111,17 @@ TEST(SceneLevelSet, ParsesShapesAndLevelSets) {
   EXPECT_DOUBLE_EQ(vdb.mesh.meshing.cell_size, 0.3);
 }
 
+TEST(SceneLevelSet, DemoSceneParses) {
+  const app::Scene scene = app::load_scene(
+      std::filesystem::path(STRATA_SOURCE_DIR) / "experiments" / "scenes" / "csg_ring.json", {});
+  ASSERT_TRUE(scene.mesh.implicit.has_value());
+  EXPECT_EQ(
+      describe_implicit_shape(*scene.mesh.implicit),
+      "difference(union(torus([0,0,0],[0,0,1],0.10000000000000001,0.029999999999999999),"
+      "capsule([-0.12,0,0],[0.12,0,0],0.02)),box([-0.20000000000000001,-0.20000000000000001,"
+      "0.014999999999999999],[0.20000000000000001,0.20000000000000001,0.20000000000000001]))");
+}
+
 TEST(SceneLevelSet, ParserErrorsNameTheKeyPath) {
   const auto implicit = [](const char* shape) {
     return ball_scene({{"implicit", json::parse(shape)}, {"cell_size", 0.3}});
