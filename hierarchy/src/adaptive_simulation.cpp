@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "strata/core/common/error.hpp"
@@ -110,8 +111,18 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   m_locator = std::make_unique<TreePointLocator>(*m_tree);
   m_controller =
       std::make_unique<RefinementController>(m_settings.criteria, make_indicator(m_settings));
-  if (is_explicit(m_solver))
+  if (is_explicit(m_solver)) {
+    if (m_settings.criteria.balance)
+      throw InputError(
+          "hierarchy.balance: not available with explicit integrators (balance refinements are "
+          "not checked against the stable step)");
     m_controller->set_refinement_veto([this](NodeId n) { return children_stable(n); });
+  }
+  // Keep Dirichlet groups exact: never merge children into a parent on which one would not be
+  // (vetoed before the controller spends its element budget).
+  m_controller->set_coarsening_veto([this](NodeId parent) {
+    return dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
+  });
   m_point_loads = finest_level_loads(*m_tree, loads, m_tolerance);
   make_dirichlet_exact();
   rebuild(0);
@@ -126,8 +137,17 @@ void AdaptiveSimulation::make_dirichlet_exact() {
   for (int pass = 0; pass <= m_tree->max_level(); ++pass) {
     const std::vector<NodeId> offenders = inexact_dirichlet_nodes(*m_cut, m_dirichlet, m_tolerance);
     if (offenders.empty()) return;
-    for (NodeId n : offenders)
+    for (NodeId n : offenders) {
+      if (is_explicit(m_solver) && !children_stable(n))
+        throw InputError("hierarchy: resolving the fixed/prescribed regions exactly needs level " +
+                         std::to_string(m_tree->level(n) + 1) + " near " +
+                         std::to_string(m_tree->tet_positions(n).rowwise().mean().x()) +
+                         ", ... whose stable "
+                         "step is below solver.dt = " +
+                         std::to_string(m_solver.dt) +
+                         " s of the explicit integrator; reduce dt or use implicit_euler");
       m_cut->refine(n);
+    }
   }
 }
 
@@ -169,6 +189,7 @@ void AdaptiveSimulation::rebuild(long first_step) {
 }
 
 void AdaptiveSimulation::advance() {
+  if (m_failed) throw std::logic_error("AdaptiveSimulation::advance: a previous cut change failed");
   const auto start = Clock::now();
   m_simulation->advance();
   m_stepping_seconds += seconds_since(start);
@@ -177,7 +198,7 @@ void AdaptiveSimulation::advance() {
       // Solve–mark–refine: re-solve the same load factor on each new cut.
       for (int pass = 0; pass < m_settings.max_passes && adapt(pass); ++pass) {
         const auto solve_start = Clock::now();
-        m_simulation->advance();
+        m_simulation->resolve_static();
         m_stepping_seconds += seconds_since(solve_start);
       }
     } else if (step_count() % m_settings.adapt_every == 0 && !finished()) {
@@ -195,11 +216,7 @@ bool AdaptiveSimulation::adapt(int pass) {
   const CutState state{
       *m_tree,           flat,       sim.positions(),  fields,          m_mesh_external,
       sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
-  CutChanges changes = m_controller->decide(state, *m_cut);
-  // Keep Dirichlet groups exact: never coarsen into a parent on which one would not be.
-  std::erase_if(changes.coarsen, [&](NodeId parent) {
-    return !dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
-  });
+  const CutChanges changes = m_controller->decide(state, *m_cut);
   if (changes.refine.empty() && changes.coarsen.empty()) {
     m_bookkeeping_seconds += seconds_since(start);
     return false;
@@ -218,18 +235,26 @@ bool AdaptiveSimulation::adapt(int pass) {
   record.refined = counts.refined + counts.balance_refined;
   record.coarsened = counts.coarsened;
 
-  // Restart on the new cut from the same step: static runs re-solve the load step just taken.
-  const long first_step = is_static(m_solver) ? sim.step_count() - 1 : sim.step_count();
+  // Restart on the new cut at the same step (static runs then re-solve that load step). The new
+  // objects are built aside and swapped in only when complete: an exception leaves the previous
+  // Simulation in place and marks the driver failed.
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
   std::unique_ptr<Simulation> old_simulation = std::move(m_simulation);
+  try {
+    rebuild(old_simulation->step_count());
+    const FlatTreeMesh& new_flat = m_constrained->flat;
+    const HangingConstraints& constraints = m_constrained->constraints;
+    const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
+    const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
+    m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
+    keep_kinetic_energy(old_cut->flat, old_cut->constraints, *old_simulation);
+  } catch (...) {
+    m_constrained = std::move(old_cut);
+    m_simulation = std::move(old_simulation);
+    m_failed = true;
+    throw;
+  }
   m_finished_counters = add(m_finished_counters, old_simulation->counters());
-  rebuild(first_step);
-  const FlatTreeMesh& new_flat = m_constrained->flat;
-  const HangingConstraints& constraints = m_constrained->constraints;
-  const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
-  const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
-  m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
-  keep_kinetic_energy(old_cut->flat, old_cut->constraints, *old_simulation);
   old_simulation.reset();
   old_cut.reset();
   for (NodeId parent : changes.coarsen)
@@ -248,11 +273,15 @@ bool AdaptiveSimulation::adapt(int pass) {
 void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
                                              const HangingConstraints& old_constraints,
                                              const Simulation& old_simulation) {
-  // Lumped masses of the same linear velocity field differ between cuts, so the transferred
-  // velocities carry a different kinetic energy (momentum is the same: Σ m_i v_i = ∫ρ v_h for
-  // lumped masses of any cut). Within the changed region S (DOF vertices that are new or whose
-  // mass changed, none of them prescribed) the deviation from S's mean velocity is scaled by s so
-  // that ½ Σ m v² matches the old value; S's momentum, hence the total, is unchanged.
+  // The transferred velocities do not carry the old kinetic energy and momentum: lumped masses of
+  // one linear field differ between cuts, and merging drops the children's detail. Within the
+  // changed region S (free DOF vertices that are new or whose mass changed) the velocities are
+  // set to v = v̄ + s (v − v̄_S): v̄_S is S's mass-weighted mean, v̄ is chosen so that the total
+  // momentum equals the old one, and s ≥ 0 so that ½ Σ m v² equals the old kinetic energy.
+  // Both can be met unless prescribed vertices took over mass from S (their lumped share grows
+  // on a coarser cut): then the mean motion of the lighter S at the old momentum would carry more
+  // energy than before, and the kinetic energy is kept instead (s = 0, v̄ along the momentum,
+  // shortened) — a cut change never adds kinetic energy.
   const FlatTreeMesh& flat = m_constrained->flat;
   const HangingConstraints& constraints = m_constrained->constraints;
   std::vector<double> old_mass(m_tree->vertex_capacity(), -1.0);
@@ -272,23 +301,34 @@ void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
   if (changed.empty()) return;
   VectorXd v = m_simulation->dof_velocities();
   double region_mass = 0.0, region_energy = 0.0;
-  Vector3d momentum = Vector3d::Zero();
+  Vector3d region_momentum = Vector3d::Zero();
   for (Index q : changed) {
     region_mass += mass[q];
-    momentum += mass[q] * v.segment<3>(3 * q);
+    region_momentum += mass[q] * v.segment<3>(3 * q);
     region_energy += 0.5 * mass[q] * v.segment<3>(3 * q).squaredNorm();
   }
-  const Vector3d mean = momentum / region_mass;
+  const Vector3d region_mean = region_momentum / region_mass;
+  const Vector3d outside_momentum = momentum(*m_simulation) - region_momentum;
+  const Vector3d mean = (momentum(old_simulation) - outside_momentum) / region_mass;
   double deviation = 0.0;
   for (Index q : changed)
-    deviation += mass[q] * (v.segment<3>(3 * q) - mean).squaredNorm();
+    deviation += mass[q] * (v.segment<3>(3 * q) - region_mean).squaredNorm();
   const double target = old_simulation.kinetic_energy() -
                         (m_simulation->kinetic_energy() - region_energy) -
                         0.5 * region_mass * mean.squaredNorm();
-  if (!(deviation > 0.0) || target < 0.0) return;  // cannot be matched by a scale: keep linear
-  const double scale = std::sqrt(2.0 * target / deviation);
+  double scale = 0.0;
+  Vector3d shifted_mean = mean;
+  if (target >= 0.0) {
+    scale = deviation > 0.0 ? std::sqrt(2.0 * target / deviation) : 0.0;
+  } else {
+    const double available =
+        old_simulation.kinetic_energy() - (m_simulation->kinetic_energy() - region_energy);
+    const double mean_energy = 0.5 * region_mass * mean.squaredNorm();
+    shifted_mean =
+        available > 0.0 ? Vector3d(mean * std::sqrt(available / mean_energy)) : Vector3d::Zero();
+  }
   for (Index q : changed)
-    v.segment<3>(3 * q) = mean + scale * (v.segment<3>(3 * q) - mean);
+    v.segment<3>(3 * q) = shifted_mean + scale * (v.segment<3>(3 * q) - region_mean);
   const VectorXd q = m_simulation->dof_positions();
   m_simulation->set_state(q, v);
 }
@@ -312,14 +352,18 @@ VectorXi AdaptiveSimulation::cell_levels() const {
 }
 
 std::vector<RootPoint> AdaptiveSimulation::locate(ConstRef<MatrixX3d> points,
-                                                  const std::string& where) const {
-  const auto [lo, hi] = bounding_box(m_constrained->flat.mesh.vertices);
-  const double tolerance = 1e-6 * (hi - lo).norm();
+                                                  const std::string& where,
+                                                  double tolerance) const {
   std::vector<RootPoint> located;
   for (Index i = 0; i < points.rows(); ++i) {
     const Vector3d p = points.row(i).transpose();
     const std::optional<TreeLocation> root = m_locator->locate_root(p, tolerance);
-    if (!root) throw InputError(where + "[" + std::to_string(i) + "]: point lies outside the mesh");
+    if (!root) {
+      char text[160];
+      std::snprintf(text, sizeof text, ".%lld: point (%g, %g, %g) lies outside the mesh",
+                    static_cast<long long>(i), p.x(), p.y(), p.z());
+      throw InputError(where + text);
+    }
     located.push_back({root->node, p});
   }
   return located;

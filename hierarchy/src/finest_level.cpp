@@ -232,24 +232,38 @@ VectorXd map_point_loads(const ActiveCut& cut, const FlatTreeMesh& flat,
 bool dirichlet_exact_on(const TetTree& tree, NodeId n, const std::vector<DirichletSpec>& groups,
                         double tolerance) {
   const int remaining = tree.max_level() - tree.level(n);
-  if (remaining <= 0) return true;
+  if (remaining <= 0 || groups.empty()) return true;
   const Matrix3x4d x = tree.tet_positions(n);
   const Ball ball = bounding_ball(x);
-  for (const DirichletSpec& group : groups) {
-    if (!region_near(group.region, ball.center, ball.radius, tolerance)) continue;
-    std::array<bool, 4> selected{};
+  std::vector<int> near;  // groups whose region may reach this tet
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g)
+    if (region_near(groups[g].region, ball.center, ball.radius, tolerance)) near.push_back(g);
+  if (near.empty()) return true;
+  // Owner of a point: the last group whose region holds it (later groups win, dirichlet.hpp).
+  const auto owner = [&](const Vector3d& p) {
+    int result = -1;
+    for (int g : near)
+      if (region_contains(groups[g].region, p, tolerance)) result = g;
+    return result;
+  };
+  std::array<int, 4> corner_owner{};
+  for (int k = 0; k < 4; ++k)
+    corner_owner[k] = owner(x.col(k));
+  // One group owns every corner and no later group reaches the tet: regions are convex, so it owns
+  // every point of the tet.
+  if (corner_owner[0] >= 0 && corner_owner[0] == near.back() &&
+      corner_owner[0] == corner_owner[1] && corner_owner[0] == corner_owner[2] &&
+      corner_owner[0] == corner_owner[3])
+    return true;
+  bool exact = true;
+  for_each_lattice_point(1 << remaining, [&](const Eigen::Vector4d& lambda) {
+    if (!exact) return;
+    const int g = owner(x * lambda);
+    if (g < 0) return;
     for (int k = 0; k < 4; ++k)
-      selected[k] = region_contains(group.region, x.col(k), tolerance);
-    if (selected[0] && selected[1] && selected[2] && selected[3]) continue;
-    bool exact = true;
-    for_each_lattice_point(1 << remaining, [&](const Eigen::Vector4d& lambda) {
-      if (!exact || !region_contains(group.region, x * lambda, tolerance)) return;
-      for (int k = 0; k < 4; ++k)
-        if (lambda[k] > 0.0 && !selected[k]) exact = false;
-    });
-    if (!exact) return false;
-  }
-  return true;
+      if (lambda[k] > 0.0 && corner_owner[k] != g) exact = false;
+  });
+  return exact;
 }
 
 std::vector<NodeId> inexact_dirichlet_nodes(const ActiveCut& cut,

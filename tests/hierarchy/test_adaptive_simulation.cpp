@@ -83,7 +83,7 @@ TEST(AdaptiveSimulation, FullModeEqualsCoreOnTheLeafMesh) {
   ASSERT_EQ(adaptive.flat().mesh.tets.rows(), leaves.mesh.tets.rows());
   ASSERT_EQ(adaptive.constraints().num_hanging(), 0);
   const MatrixX3d probe = (MatrixX3d(1, 3) << 1.0, 0.125, 0.125).finished();
-  const MatrixX3d u = adaptive.displacements(adaptive.locate(probe, "probes"));
+  const MatrixX3d u = adaptive.displacements(adaptive.locate(probe, "probes", 1e-9));
   // Same vertices in the same order (flattening is deterministic): compare positions directly.
   EXPECT_LT((adaptive.simulation().positions() - reference.positions()).lpNorm<Eigen::Infinity>(),
             1e-9 * std::abs(u(0, 2)));
@@ -165,7 +165,7 @@ TEST(AdaptiveSimulation, SmallFixedPatchIsResolvedExactly) {
   // Finest-level material points inside the patch follow it too (probes between vertices).
   MatrixX3d probes(2, 3);
   probes << 0.2, 0.3, 0.5, 0.37, 0.13, 0.5;
-  const MatrixX3d u = sim.displacements(sim.locate(probes, "probes"));
+  const MatrixX3d u = sim.displacements(sim.locate(probes, "probes", 1e-9));
   for (Index i = 0; i < 2; ++i)
     EXPECT_LT((u.row(i).transpose() - push.displacement).norm(), 1e-12);
 }
@@ -183,7 +183,7 @@ struct PressedSlab {
                            static_settings(2));
     run(sim);
     if (tets) *tets = sim.cut().size();
-    return sim.displacements(sim.locate(probe, "probes"))(0, 2);
+    return sim.displacements(sim.locate(probe, "probes", 1e-9))(0, 2);
   }
 };
 

@@ -200,6 +200,26 @@ void Simulation::advance_dynamic() {
                    to_string(m_settings.integrator));
 }
 
+void Simulation::resolve_static() {
+  STRATA_VERIFY(is_static(m_settings) && m_steps > 0,
+                "Simulation::resolve_static needs static mode after a load step");
+  const double lambda = load_factor();
+  VectorXd guess = m_x;
+  const NewtonResult result = m_static->solve(lambda, guess);
+  m_newton_iterations += result.iterations;
+  if (!result.converged)
+    throw DivergenceError("static: Newton did not converge re-solving load step " +
+                              std::to_string(m_steps) + ", load factor " + std::to_string(lambda) +
+                              " after " + std::to_string(result.iterations) +
+                              " iterations (gradient norm " + format_number(result.residual) +
+                              " N)",
+                          m_steps, lambda);
+  m_x = guess;
+  m_x_previous = m_x;  // no extrapolation from a state of another mesh
+  update_mesh_state();
+  check_divergence(*m_model, positions(), VectorXd(), m_limits, m_steps, lambda, "static");
+}
+
 void Simulation::advance_static() {
   const double lambda = static_cast<double>(m_steps + 1) / m_settings.load_steps;
   VectorXd guess = m_x;

@@ -145,7 +145,9 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   Index constrained = 0;
   std::vector<std::string> groups;
   for (const DirichletGroup& group : simulation.dirichlet_groups()) {
-    constrained += 3 * static_cast<Index>(group.vertices.size());
+    const Index components =
+        group.spec.components[0] + group.spec.components[1] + group.spec.components[2];
+    constrained += components * static_cast<Index>(group.vertices.size());
     groups.push_back(group.spec.name);
   }
   stats["free_dofs"] = simulation.embedded_model().num_dofs() - constrained;
@@ -223,7 +225,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   std::vector<RootPoint> probe_roots;
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive()) {
     try {
-      probe_roots = adaptive->locate(probe_points, "output.probes");
+      probe_roots =
+          adaptive->locate(probe_points, "output.probes", kProbeToleranceFactor * diagonal);
     } catch (const InputError& error) {
       throw InputError(scene.file.string() + ": " + error.what());
     }

@@ -24,17 +24,21 @@
 ///
 /// Explicit integrators: refinement of a node is refused (vetoed) when its children's stable step
 /// estimate (stable_time_step.hpp) falls below the scene's dt; the time step is never changed, so
-/// outputs stay on the scene's time grid. Implicit integrators and static runs refine freely.
+/// outputs stay on the scene's time grid. If exact fixed/prescribed regions need such a level, the
+/// construction throws InputError (reduce dt or use implicit Euler); 2:1 balance is refused with
+/// explicit integrators. Implicit integrators and static runs refine freely.
 ///
 /// Fixed and prescribed regions stay exact: before the run, active tets on which a group is not
 /// exact are refined until it is, and such parents are never coarsened into (finest_level.hpp).
 ///
-/// Energy at transfers: kinetic + elastic energy just before and just after each cut change is
-/// recorded (`changes()`). Refinement keeps the elastic energy exactly (the new vertices lie on the
-/// old linear field); coarsening loses the elastic energy of the fine detail the parent cannot
-/// represent. Kinetic energy: lumped masses of the same linear velocity field differ between
-/// cuts (momentum does not), so within the changed region the velocities' deviation from the
-/// region's mean velocity is rescaled to keep ½ Σ m v² and the momentum exactly.
+/// Energy at transfers: kinetic + elastic energy and momentum just before and just after each cut
+/// change are recorded (`changes()`). Refinement keeps the elastic energy exactly (the new vertices
+/// lie on the old linear field); coarsening loses the elastic energy of the fine detail the parent
+/// cannot represent. Velocities: lumped masses of one linear field differ between cuts, so within
+/// the changed region the velocities' deviation from the region's mean is rescaled and the mean
+/// shifted to keep ½ Σ m v² and the momentum exactly; when prescribed vertices took over mass from
+/// the region (coarser cuts lump more mass onto them), both cannot hold and the kinetic energy is
+/// kept with the momentum's direction (a cut change never adds kinetic energy).
 #include <memory>
 #include <optional>
 #include <string>
@@ -125,10 +129,11 @@ class AdaptiveSimulation {
   const HierarchySettings& settings() const { return m_settings; }
   const RefinementController& controller() const { return *m_controller; }
 
-  /// Material points at rest positions `points` (n × 3), each located in its root; throws
-  /// InputError naming the point (`where`[i]) if a point is outside the coarse mesh (beyond 10⁻⁶
-  /// of its bounding-box diagonal).
-  std::vector<RootPoint> locate(ConstRef<MatrixX3d> points, const std::string& where) const;
+  /// Material points at rest positions `points` (n × 3), each located in its root (the nearest
+  /// root within `tolerance` [m] for points just outside); throws InputError naming the point
+  /// (`where`.i) if a point is farther than `tolerance` from the coarse mesh.
+  std::vector<RootPoint> locate(ConstRef<MatrixX3d> points, const std::string& where,
+                                double tolerance) const;
   /// Displacements (n × 3) of material points on the current cut, interpolated in the active
   /// ancestor of the leaf that contains each.
   MatrixX3d displacements(const std::vector<RootPoint>& points) const;
@@ -147,6 +152,7 @@ class AdaptiveSimulation {
   void rebuild(long first_step);
   bool adapt(int pass);
   bool children_stable(NodeId n) const;
+  bool m_failed = false;  ///< a cut change threw: the cut no longer matches the Simulation
   void record_sample();
   void keep_kinetic_energy(const FlatTreeMesh& old_flat, const HangingConstraints& old_constraints,
                            const Simulation& old_simulation);

@@ -15,11 +15,12 @@
 ///   triangle qualifies, the force is split equally over the finest-level lattice points in the
 ///   region.
 /// - Dirichlet regions (`inexact_dirichlet_nodes`): a group is exact on a cut if for every
-///   finest-level point it selects, every active corner that interpolates that point (λ > 0) is
-///   selected by the group too — then the finest vertices in the region follow the prescribed
-///   motion exactly. The adaptive driver refines active tets until this holds and never coarsens
-///   into a parent for which it fails ("keep them exact"). For a clamped face this holds on the
-///   coarse mesh already; a small clamped patch inside a coarse face forces refinement there.
+///   finest-level point it owns (the last group whose region holds it), every active corner that
+///   interpolates that point (λ > 0) is owned by the group too — then the finest vertices in the
+///   region follow the prescribed motion exactly. The adaptive driver refines active tets until
+///   this holds and never coarsens into a parent for which it fails ("keep them exact"). For a
+///   clamped face this holds on the coarse mesh already; a small clamped patch inside a coarse face
+///   forces refinement there.
 ///
 /// Gravity needs no special treatment: the lumped masses of any cut give ρ g ∫ N_i dV exactly for a
 /// constant body force, which equals the finest level's loads carried by the weights above.
@@ -77,8 +78,9 @@ std::vector<PointLoad> finest_level_loads(const TetTree& tree, const std::vector
 VectorXd map_point_loads(const ActiveCut& cut, const FlatTreeMesh& flat,
                          const std::vector<PointLoad>& loads, VectorXd* tet_traction = nullptr);
 
-/// Whether every Dirichlet group is exact on node `n` (see the file comment): for each finest
-/// lattice point of `n` that a group selects, all corners of `n` with λ > 0 are selected by it.
+/// Whether every Dirichlet group is exact on node `n` (see the file comment): each finest lattice
+/// point of `n` owned by a group (the last group whose region holds it, as in dirichlet.hpp) is
+/// interpolated only from corners of `n` (λ > 0) owned by that same group.
 bool dirichlet_exact_on(const TetTree& tree, NodeId n, const std::vector<DirichletSpec>& groups,
                         double tolerance);
 

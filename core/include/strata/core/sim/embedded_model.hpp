@@ -88,7 +88,7 @@ class EmbeddedElasticModel {
   SparseMatrixd m_C;
   SparseMatrixd m_CT;  ///< Cᵀ, for reductions
   SparseMatrixd m_pattern;
-  std::vector<Term> m_terms;  ///< sorted by target
+  std::vector<Term> m_terms;  ///< in the order of the mesh pattern's values (sources)
   mutable SparseMatrixd m_mesh_stiffness;
 };
 

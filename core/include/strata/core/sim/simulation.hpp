@@ -95,6 +95,12 @@ class Simulation {
   /// step and time (or load factor) if the state diverges or Newton fails; std::logic_error if
   /// called when finished().
   void advance();
+  /// Static mode only: re-solves the equilibrium at the current load factor, starting from the
+  /// current state (e.g. after a driver carried the state over to a new mesh with
+  /// SimulationOptions::first_step = the step just taken). The step count is unchanged; the next
+  /// load step starts from this solution without extrapolation. Throws DivergenceError as
+  /// advance(); std::logic_error in dynamic mode or before the first load step.
+  void resolve_static();
   /// Dynamic: t ≥ duration (up to 10⁻⁹ dt; the last step is not shortened, so the run takes
   /// ⌈duration/dt⌉ steps). Static: all load_steps done.
   bool finished() const;
