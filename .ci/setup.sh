@@ -13,7 +13,7 @@ jobs="${STRATA_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 packages=(
   build-essential cmake g++ make
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libsuitesparse-dev
-  libopenblas0-pthread libgtest-dev googletest libbenchmark-dev
+  libopenblas0-pthread libgtest-dev libgmock-dev googletest libbenchmark-dev
   libcgal-dev libcgal-demo libopenvdb-dev libboost-iostreams-dev
   python3-matplotlib python3-meshio clang-format
 )
