@@ -4,32 +4,9 @@
 
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/io/number_text.hpp"
+#include "vtk_xml.hpp"
 
 namespace strata {
-namespace {
-
-void write_escaped(std::ostream& out, const std::string& text) {
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out << "&amp;";
-        break;
-      case '<':
-        out << "&lt;";
-        break;
-      case '>':
-        out << "&gt;";
-        break;
-      case '"':
-        out << "&quot;";
-        break;
-      default:
-        out << c;
-    }
-  }
-}
-
-}  // namespace
 
 PvdWriter::PvdWriter(std::filesystem::path pvd_path) : m_path(std::move(pvd_path)) {
   write();
@@ -54,7 +31,7 @@ void PvdWriter::write() const {
       out << "    <DataSet timestep=\"";
       write_double(out, entry.time);
       out << "\" group=\"\" part=\"" << entry.part << "\" file=\"";
-      write_escaped(out, entry.file);
+      out << vtk_xml::escape(entry.file);
       out << "\"/>\n";
     }
     out << "  </Collection>\n</VTKFile>\n";
