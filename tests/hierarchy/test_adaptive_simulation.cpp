@@ -3,6 +3,7 @@
 // resolution, energy at refinement, and the explicit step limit.
 #include <gtest/gtest.h>
 
+#include "adaptive_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/region.hpp"
@@ -13,35 +14,16 @@
 namespace strata {
 namespace {
 
-Material rubber() {
-  Material material;
-  material.model = MaterialModel::neohookean;
-  material.youngs_modulus = 1e6;
-  material.poisson_ratio = 0.3;
-  material.density = 1000.0;
-  return material;
-}
+using testing::box_load;
+using testing::fixed_plane;
+using testing::hierarchy;
+using testing::rubber;
 
 SolverSettings static_settings(int load_steps) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = load_steps;
   return settings;
-}
-
-DirichletSpec fixed_plane(const std::string& name, const Vector3d& point, const Vector3d& normal) {
-  DirichletSpec spec;
-  spec.name = name;
-  spec.region = PlaneRegion{point, normal, 0.0};
-  return spec;
-}
-
-RegionLoad box_load(const Vector3d& lo, const Vector3d& hi, const Vector3d& force) {
-  RegionLoad load;
-  load.name = "forces.0";
-  load.region = BoxRegion{lo, hi};
-  load.total_force = force;
-  return load;
 }
 
 /// A 1 × 0.25 × 0.25 bar clamped at x = 0 with a shear load on its end face.
@@ -52,14 +34,6 @@ struct Bar {
       box_load(Vector3d(1, -1, -1), Vector3d(1, 1, 1), Vector3d(0, 0, -200.0))};
   Vector3d gravity = Vector3d(0, 0, -9.81);
 };
-
-HierarchySettings hierarchy(int levels, HierarchyMode mode, int level = 0) {
-  HierarchySettings settings;
-  settings.levels = levels;
-  settings.mode = mode;
-  settings.level = level;
-  return settings;
-}
 
 template <typename Sim>
 void run(Sim& sim) {

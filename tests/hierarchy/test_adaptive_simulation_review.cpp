@@ -3,6 +3,7 @@
 // cut, and the explicit step limit when fixed regions force refinement.
 #include <gtest/gtest.h>
 
+#include "adaptive_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/region.hpp"
@@ -12,30 +13,6 @@
 
 namespace strata {
 namespace {
-
-Material bug_rubber() {
-  Material material;
-  material.model = MaterialModel::neohookean;
-  material.youngs_modulus = 1e6;
-  material.poisson_ratio = 0.3;
-  material.density = 1000.0;
-  return material;
-}
-
-DirichletSpec bug_plane(const std::string& name, const Vector3d& point, const Vector3d& normal) {
-  DirichletSpec spec;
-  spec.name = name;
-  spec.region = PlaneRegion{point, normal, 0.0};
-  return spec;
-}
-
-HierarchySettings bug_hierarchy(int levels, HierarchyMode mode, int level) {
-  HierarchySettings settings;
-  settings.levels = levels;
-  settings.mode = mode;
-  settings.level = level;
-  return settings;
-}
 
 Vector3d momentum(const Simulation& sim) {
   Vector3d p = Vector3d::Zero();
@@ -60,16 +37,16 @@ CoarseningRun coarsen_after_five_steps(const std::vector<DirichletSpec>& fixed,
   settings.integrator = Integrator::implicit_euler;
   settings.dt = 2e-3;
   settings.duration = 0.02;
-  HierarchySettings h = bug_hierarchy(1, HierarchyMode::adaptive, 1);
+  HierarchySettings h = testing::hierarchy(1, HierarchyMode::adaptive, 1);
   h.adapt_every = 5;
   h.criteria.refine_threshold = 1e30;
   h.criteria.coarsen_indicator_fraction = 1.0;
   h.criteria.coarsen_tolerance = 1e6;
   h.criteria.min_steps_between_changes = 0;
-  AdaptiveSimulation adaptive(coarse, h, bug_rubber(), fixed, loads, std::nullopt, gravity,
+  AdaptiveSimulation adaptive(coarse, h, testing::rubber(), fixed, loads, std::nullopt, gravity,
                               settings);
   // Independent reference for the state just before the change: the same level-1 mesh.
-  Simulation reference(adaptive.flat().mesh, bug_rubber(), fixed, loads, std::nullopt, gravity,
+  Simulation reference(adaptive.flat().mesh, testing::rubber(), fixed, loads, std::nullopt, gravity,
                        settings);
   for (int k = 0; k < 5; ++k) {
     adaptive.advance();
@@ -97,7 +74,8 @@ TEST(AdaptiveSimulationReview, CoarseningNeverAddsKineticEnergyNextToAClamp) {
   // The clamped vertices take over lumped mass on the coarse cut: the free DOFs cannot keep both;
   // the kinetic energy is kept and the momentum keeps its direction without growing.
   const CoarseningRun run = coarsen_after_five_steps(
-      {bug_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX())}, {}, Vector3d(0, 0, -9.81));
+      {testing::fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX())}, {},
+      Vector3d(0, 0, -9.81));
   EXPECT_NEAR(run.ke_after, run.ke_before, 1e-9 * run.ke_before);
   EXPECT_LE(run.p_after.norm(), run.p_before.norm() * (1 + 1e-12));
   EXPECT_GT(run.p_after.normalized().dot(run.p_before.normalized()), 1 - 1e-9);
@@ -107,7 +85,7 @@ TEST(AdaptiveSimulationReview, CoarseningNeverAddsKineticEnergyNextToAClamp) {
 // recorded energy_after of a pure refinement is not the energy of the transferred state.
 TEST(AdaptiveSimulationReview, StaticRefinementRecordKeepsEnergyWithPrescribedDisplacement) {
   const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.25), {4, 4, 1});
-  DirichletSpec lift = bug_plane("lift.0", Vector3d::Zero(), Vector3d::UnitZ());
+  DirichletSpec lift = testing::fixed_plane("lift.0", Vector3d::Zero(), Vector3d::UnitZ());
   lift.kind = DirichletKind::displacement;
   lift.displacement = Vector3d(0, 0, 0.003);
   RegionLoad load;
@@ -117,8 +95,9 @@ TEST(AdaptiveSimulationReview, StaticRefinementRecordKeepsEnergyWithPrescribedDi
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 2;
-  AdaptiveSimulation sim(coarse, bug_hierarchy(2, HierarchyMode::adaptive, 0), bug_rubber(), {lift},
-                         {load}, std::nullopt, Vector3d::Zero(), settings);
+  AdaptiveSimulation sim(coarse, testing::hierarchy(2, HierarchyMode::adaptive, 0),
+                         testing::rubber(), {lift}, {load}, std::nullopt, Vector3d::Zero(),
+                         settings);
   while (!sim.finished())
     sim.advance();
   ASSERT_FALSE(sim.changes().empty());
@@ -133,7 +112,8 @@ TEST(AdaptiveSimulationReview, StaticRefinementRecordKeepsEnergyWithPrescribedDi
 // are interpolated from the later group's corners.
 TEST(AdaptiveSimulationReview, OverlappingGroupsStayExactOnTheCut) {
   const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.5), {2, 2, 1});
-  std::vector<DirichletSpec> groups = {bug_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
+  std::vector<DirichletSpec> groups = {
+      testing::fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
   DirichletSpec slide;
   slide.name = "prescribed.0";
   slide.region = BoxRegion{Vector3d(0.125, 0.125, 0.0), Vector3d(0.375, 0.375, 0.0)};
@@ -155,7 +135,7 @@ TEST(AdaptiveSimulationReview, OverlappingGroupsStayExactOnTheCut) {
   for (size_t k = 0; k < points.size(); ++k)
     probes.row(static_cast<Index>(k)) = points[k].transpose();
   for (const HierarchyMode mode : {HierarchyMode::full, HierarchyMode::uniform}) {
-    AdaptiveSimulation sim(coarse, bug_hierarchy(3, mode, 0), bug_rubber(), groups, {},
+    AdaptiveSimulation sim(coarse, testing::hierarchy(3, mode, 0), testing::rubber(), groups, {},
                            std::nullopt, Vector3d::Zero(), settings);
     while (!sim.finished())
       sim.advance();
@@ -174,7 +154,8 @@ TEST(AdaptiveSimulationReview, OverlappingGroupsStayExactOnTheCut) {
 // below dt, the run is refused up front (it would otherwise diverge within a few steps).
 TEST(AdaptiveSimulationReview, ExplicitRunNeverStartsBelowItsStableStep) {
   const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.5), {2, 2, 1});
-  std::vector<DirichletSpec> groups = {bug_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
+  std::vector<DirichletSpec> groups = {
+      testing::fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
   DirichletSpec push;
   push.name = "prescribed.0";
   push.region = BoxRegion{Vector3d(0.125, 0.125, 0.5), Vector3d(0.375, 0.375, 0.5)};
@@ -186,20 +167,20 @@ TEST(AdaptiveSimulationReview, ExplicitRunNeverStartsBelowItsStableStep) {
   settings.dt = 1.0;
   settings.duration = 1.0;
   const double coarse_dt =
-      Simulation(coarse, bug_rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings)
+      Simulation(coarse, testing::rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings)
           .stable_dt_estimate();
   settings.dt = 0.9 * coarse_dt;
   settings.duration = 400 * settings.dt;
   EXPECT_THROW(
-      AdaptiveSimulation(coarse, bug_hierarchy(3, HierarchyMode::adaptive, 0), bug_rubber(), groups,
-                         {}, std::nullopt, Vector3d::Zero(), settings),
+      AdaptiveSimulation(coarse, testing::hierarchy(3, HierarchyMode::adaptive, 0),
+                         testing::rubber(), groups, {}, std::nullopt, Vector3d::Zero(), settings),
       InputError);
   // Small enough a step: the run starts on the refined cut, above its stable step, and stays
   // finite.
   settings.dt = 0.1 * coarse_dt;
   settings.duration = 50 * settings.dt;
-  AdaptiveSimulation sim(coarse, bug_hierarchy(3, HierarchyMode::adaptive, 0), bug_rubber(), groups,
-                         {}, std::nullopt, Vector3d::Zero(), settings);
+  AdaptiveSimulation sim(coarse, testing::hierarchy(3, HierarchyMode::adaptive, 0),
+                         testing::rubber(), groups, {}, std::nullopt, Vector3d::Zero(), settings);
   EXPECT_GT(sim.cut().finest_level(), 0);
   EXPECT_GE(sim.simulation().stable_dt_estimate(), settings.dt);
   EXPECT_NO_THROW(while (!sim.finished()) sim.advance());

@@ -2,6 +2,7 @@
 // equals a direct solve on its final cut (prescribed displacement, roller support, loaded patch).
 #include <gtest/gtest.h>
 
+#include "adaptive_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/region.hpp"
@@ -11,30 +12,6 @@
 
 namespace strata {
 namespace {
-
-Material review_rubber() {
-  Material material;
-  material.model = MaterialModel::neohookean;
-  material.youngs_modulus = 1e6;
-  material.poisson_ratio = 0.3;
-  material.density = 1000.0;
-  return material;
-}
-
-DirichletSpec plane_group(const std::string& name, const Vector3d& point, const Vector3d& normal) {
-  DirichletSpec spec;
-  spec.name = name;
-  spec.region = PlaneRegion{point, normal, 0.0};
-  return spec;
-}
-
-RegionLoad patch_load(const Vector3d& lo, const Vector3d& hi, const Vector3d& force) {
-  RegionLoad load;
-  load.name = "forces.0";
-  load.region = BoxRegion{lo, hi};
-  load.total_force = force;
-  return load;
-}
 
 HierarchySettings adaptive_from_coarse(int levels) {
   HierarchySettings settings;
@@ -49,14 +26,14 @@ HierarchySettings adaptive_from_coarse(int levels) {
 struct RollerSlab {
   TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.25), {4, 4, 1});
   std::vector<DirichletSpec> groups;
-  std::vector<RegionLoad> loads = {
-      patch_load(Vector3d(0.6, 0.4, 0.25), Vector3d(0.75, 0.6, 0.25), Vector3d(0, 0, -400.0))};
+  std::vector<RegionLoad> loads = {testing::box_load(
+      Vector3d(0.6, 0.4, 0.25), Vector3d(0.75, 0.6, 0.25), Vector3d(0, 0, -400.0))};
 
   RollerSlab() {
-    DirichletSpec roller = plane_group("roller.0", Vector3d::Zero(), Vector3d::UnitZ());
+    DirichletSpec roller = testing::fixed_plane("roller.0", Vector3d::Zero(), Vector3d::UnitZ());
     roller.components = {false, false, true};
     groups.push_back(roller);
-    groups.push_back(plane_group("fixed.0", Vector3d::Zero(), Vector3d::UnitX()));
+    groups.push_back(testing::fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX()));
     DirichletSpec push;
     push.name = "prescribed.0";
     push.region = BoxRegion{Vector3d(0.25, 0, 0.25), Vector3d(0.5, 1, 0.25)};
@@ -71,7 +48,7 @@ TEST(ReviewAdaptiveSimulation, StaticAdaptiveRunEqualsADirectSolveOnItsFinalCut)
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 3;
-  AdaptiveSimulation adaptive(slab.coarse, adaptive_from_coarse(2), review_rubber(), slab.groups,
+  AdaptiveSimulation adaptive(slab.coarse, adaptive_from_coarse(2), testing::rubber(), slab.groups,
                               slab.loads, std::nullopt, Vector3d::Zero(), settings);
   while (!adaptive.finished())
     adaptive.advance();
@@ -87,7 +64,7 @@ TEST(ReviewAdaptiveSimulation, StaticAdaptiveRunEqualsADirectSolveOnItsFinalCut)
   options.vertex_embedding = adaptive.constraints().matrix();
   options.dof_vertices = adaptive.constraints().free_vertices();
   options.extra_mesh_forces = map_point_loads(adaptive.cut(), flat, point_loads);
-  Simulation direct(flat.mesh, review_rubber(), slab.groups, {}, std::nullopt, Vector3d::Zero(),
+  Simulation direct(flat.mesh, testing::rubber(), slab.groups, {}, std::nullopt, Vector3d::Zero(),
                     settings, options);
   while (!direct.finished())
     direct.advance();
