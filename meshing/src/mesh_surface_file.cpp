@@ -34,9 +34,13 @@ SurfaceMeshingResult mesh_surface_file(const std::filesystem::path& file,
   SurfaceMesh surface = read_surface(file);
   result.surface = describe_surface(surface);
   remove_degenerate_triangles(surface);
-  const bool polyhedral = is_closed_manifold_surface(surface);
+  const bool closed_manifold = is_closed_manifold_surface(surface);
+  const bool self_intersecting = closed_manifold && surface_self_intersects(surface);
+  const bool polyhedral = closed_manifold && !self_intersecting;
   result.report.route = polyhedral ? "polyhedral" : "level set";
-  if (!polyhedral) {
+  if (self_intersecting) {
+    result.warning = name + ": surface intersects itself: meshed through a level set";
+  } else if (!polyhedral) {
     result.warning =
         name + ": surface " + result.surface.topology.summary() + ": meshed through a level set";
   }

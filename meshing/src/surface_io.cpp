@@ -6,6 +6,9 @@
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
 #include <array>
@@ -13,6 +16,7 @@
 #include <cmath>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -127,6 +131,25 @@ SurfaceMesh read_surface(const std::filesystem::path& path) {
                      " triangles are degenerate (zero area)");
   }
   return surface;
+}
+
+bool surface_self_intersects(const SurfaceMesh& surface) {
+  std::vector<Point> points;
+  points.reserve(static_cast<size_t>(surface.vertices.rows()));
+  for (Index v = 0; v < surface.vertices.rows(); ++v)
+    points.emplace_back(surface.vertices(v, 0), surface.vertices(v, 1), surface.vertices(v, 2));
+  std::vector<std::array<std::size_t, 3>> polygons;
+  polygons.reserve(static_cast<size_t>(surface.triangles.rows()));
+  for (Index t = 0; t < surface.triangles.rows(); ++t)
+    polygons.push_back({static_cast<std::size_t>(surface.triangles(t, 0)),
+                        static_cast<std::size_t>(surface.triangles(t, 1)),
+                        static_cast<std::size_t>(surface.triangles(t, 2))});
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
+    throw std::logic_error("surface_self_intersects: the surface is not an oriented manifold");
+  CGAL::Surface_mesh<Point> mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  return PMP::does_self_intersect(mesh);
 }
 
 }  // namespace strata

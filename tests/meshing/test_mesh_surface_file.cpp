@@ -9,6 +9,8 @@
 #include "strata/core/common/error.hpp"
 #include "strata/meshing/mesh_cache.hpp"
 #include "strata/meshing/mesh_surface_file.hpp"
+#include "strata/meshing/surface_io.hpp"
+#include "strata/meshing/tetrahedralize.hpp"
 
 namespace strata {
 namespace {
@@ -139,6 +141,42 @@ TEST_F(MeshSurfaceFile, ErrorsNameTheFile) {
   options.facet_angle = 40.0;
   EXPECT_EQ(error_of(box, options),
             box.string() + ": meshing: facet_angle must be in (0, 30] degrees");
+}
+
+/// Two closed boxes in one file that overlap: each closed and manifold, together self-intersecting.
+SurfaceMesh overlapping_boxes() {
+  const SurfaceMesh a = testing::box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  const SurfaceMesh b = testing::box_surface(Vector3d(0.5, 0.25, 0.25), Vector3d(1.5, 0.75, 0.75));
+  SurfaceMesh both;
+  both.vertices.resize(a.vertices.rows() + b.vertices.rows(), 3);
+  both.vertices << a.vertices, b.vertices;
+  both.triangles.resize(a.triangles.rows() + b.triangles.rows(), 3);
+  both.triangles << a.triangles,
+      (b.triangles.array() + static_cast<int>(a.vertices.rows())).matrix();
+  return both;
+}
+
+TEST_F(MeshSurfaceFile, SelfIntersectingClosedSurfaceTakesTheLevelSetRoute) {
+  const SurfaceMesh box = testing::box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
+  EXPECT_FALSE(surface_self_intersects(box));
+  const SurfaceMesh both = overlapping_boxes();
+  ASSERT_TRUE(is_closed_manifold_surface(both));
+  EXPECT_TRUE(surface_self_intersects(both));
+  const SurfaceMeshingResult result =
+      mesh_surface_file(write_off("overlap.off", both), options_with_cell_size(0.2));
+  EXPECT_EQ(result.report.route, "level set");
+  EXPECT_NE(result.warning.find("intersects itself"), std::string::npos) << result.warning;
+  // The level set meshes the union: 1 + 0.5 · 0.5 · 0.5 (the part of the second box outside the
+  // first), within the meshing tolerance of a 0.2 cell size on a 1.5 m body.
+  double volume = 0.0;
+  for (Index t = 0; t < result.mesh.tets.rows(); ++t) {
+    const Vector3d x0 = result.mesh.vertices.row(result.mesh.tets(t, 0)).transpose();
+    volume += (result.mesh.vertices.row(result.mesh.tets(t, 1)).transpose() - x0)
+                  .cross(result.mesh.vertices.row(result.mesh.tets(t, 2)).transpose() - x0)
+                  .dot(result.mesh.vertices.row(result.mesh.tets(t, 3)).transpose() - x0) /
+              6.0;
+  }
+  EXPECT_NEAR(volume, 1.125, 0.1);
 }
 
 TEST(MeshingReport, SurfaceReportCountsDefects) {

@@ -15,4 +15,10 @@ namespace strata {
 /// of range, has no triangle, or has only degenerate triangles.
 SurfaceMesh read_surface(const std::filesystem::path& path);
 
+/// Whether two triangles of a closed, edge-manifold surface intersect other than at shared
+/// vertices or edges (CGAL Polygon_mesh_processing::does_self_intersect). Such a surface cannot
+/// bound a polyhedral Mesh_3 domain; mesh_surface_file routes it through a level set instead.
+/// Precondition: is_closed_manifold_surface(surface) (std::logic_error otherwise).
+bool surface_self_intersects(const SurfaceMesh& surface);
+
 }  // namespace strata
