@@ -9,6 +9,8 @@
 
 #include "cli_test_utils.hpp"
 #include "strata/core/common/types.hpp"
+#include "strata/core/mesh/point_location.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
 
 namespace strata::cli_test {
 
@@ -80,6 +82,34 @@ inline MatrixX3d read_vtp_points(const std::filesystem::path& path) {
   for (std::size_t k = 0; k < values.size(); ++k)
     result(static_cast<Index>(k / 3), static_cast<Index>(k % 3)) = values[k];
   return result;
+}
+
+/// Checks a deformed surface frame against the volume frame it belongs to: every surface vertex
+/// inside the rest tet mesh equals the barycentric interpolation of the deformed volume (computed
+/// here with the core's point locator), at least a quarter of the vertices are inside, and no
+/// vertex moved more than 1.5 × the volume's largest displacement (outside ones extrapolate).
+inline void expect_surface_follows_volume(const MatrixX3d& surface_rest,
+                                          const MatrixX3d& surface_deformed, const TetMesh& rest,
+                                          const TetMesh& deformed) {
+  ASSERT_EQ(deformed.vertices.rows(), rest.vertices.rows());
+  ASSERT_EQ(surface_deformed.rows(), surface_rest.rows());
+  const double sag = (deformed.vertices - rest.vertices).rowwise().norm().maxCoeff();
+  EXPECT_GT(sag, 1e-4);
+  const TetLocator locator(rest.vertices, rest.tets);
+  Index inside = 0;
+  for (Index i = 0; i < surface_rest.rows(); ++i) {
+    const std::optional<TetLocation> location =
+        locator.locate(surface_rest.row(i).transpose(), 0.0);
+    if (!location || location->distance > 0.0) continue;
+    ++inside;
+    Vector3d expected = Vector3d::Zero();
+    for (int k = 0; k < 4; ++k)
+      expected +=
+          location->barycentric(k) * deformed.vertices.row(rest.tets(location->tet, k)).transpose();
+    EXPECT_LT((surface_deformed.row(i).transpose() - expected).norm(), 1e-12) << "vertex " << i;
+  }
+  EXPECT_GT(inside, surface_rest.rows() / 4);
+  EXPECT_LT((surface_deformed - surface_rest).rowwise().norm().maxCoeff(), 1.5 * sag);
 }
 
 }  // namespace strata::cli_test
