@@ -81,4 +81,35 @@ void write_data_array(std::ostream& out, const std::string& name, const Eigen::M
   write_array(out, "Int32", name, values);
 }
 
+void write_fields_and_points(std::ostream& out, const VtuFields& fields,
+                             ConstRef<MatrixX3d> positions) {
+  if (!fields.point_data.empty() || !fields.point_int_data.empty()) {
+    out << "      <PointData>\n";
+    for (const auto& [name, values] : fields.point_data)
+      write_data_array(out, name, values);
+    for (const auto& [name, values] : fields.point_int_data)
+      write_data_array(out, name, values);
+    out << "      </PointData>\n";
+  }
+  if (!fields.cell_data.empty() || !fields.cell_int_data.empty()) {
+    out << "      <CellData>\n";
+    for (const auto& [name, values] : fields.cell_data)
+      write_data_array(out, name, values);
+    for (const auto& [name, values] : fields.cell_int_data)
+      write_data_array(out, name, values);
+    out << "      </CellData>\n";
+  }
+  out << "      <Points>\n"
+         "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (Index v = 0; v < positions.rows(); ++v) {
+    out << "         ";
+    for (int d = 0; d < 3; ++d) {
+      out << ' ';
+      write_double(out, positions(v, d));
+    }
+    out << '\n';
+  }
+  out << "        </DataArray>\n      </Points>\n";
+}
+
 }  // namespace strata::vtk_xml

@@ -21,4 +21,9 @@ void check_field_rows(const std::filesystem::path& path, const VtuFields& fields
 void write_data_array(std::ostream& out, const std::string& name, const Eigen::MatrixXd& values);
 void write_data_array(std::ostream& out, const std::string& name, const Eigen::MatrixXi& values);
 
+/// The <PointData> and <CellData> of `fields` (each only if non-empty), then <Points> with
+/// `positions` (#V × 3), as a piece of a .vtu or .vtp writes them.
+void write_fields_and_points(std::ostream& out, const VtuFields& fields,
+                             ConstRef<MatrixX3d> positions);
+
 }  // namespace strata::vtk_xml

@@ -27,33 +27,8 @@ void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
            "  <UnstructuredGrid>\n"
         << "    <Piece NumberOfPoints=\"" << num_points << "\" NumberOfCells=\"" << num_cells
         << "\">\n";
-    if (!fields.point_data.empty() || !fields.point_int_data.empty()) {
-      out << "      <PointData>\n";
-      for (const auto& [name, values] : fields.point_data)
-        vtk_xml::write_data_array(out, name, values);
-      for (const auto& [name, values] : fields.point_int_data)
-        vtk_xml::write_data_array(out, name, values);
-      out << "      </PointData>\n";
-    }
-    if (!fields.cell_data.empty() || !fields.cell_int_data.empty()) {
-      out << "      <CellData>\n";
-      for (const auto& [name, values] : fields.cell_data)
-        vtk_xml::write_data_array(out, name, values);
-      for (const auto& [name, values] : fields.cell_int_data)
-        vtk_xml::write_data_array(out, name, values);
-      out << "      </CellData>\n";
-    }
-    out << "      <Points>\n"
-           "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (Index v = 0; v < num_points; ++v) {
-      out << "         ";
-      for (int d = 0; d < 3; ++d) {
-        out << ' ';
-        write_double(out, positions(v, d));
-      }
-      out << '\n';
-    }
-    out << "        </DataArray>\n      </Points>\n      <Cells>\n"
+    vtk_xml::write_fields_and_points(out, fields, positions);
+    out << "            <Cells>\n"
            "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
     for (Index t = 0; t < num_cells; ++t)
       out << "          " << tets(t, 0) << ' ' << tets(t, 1) << ' ' << tets(t, 2) << ' '
