@@ -1,16 +1,17 @@
 // One backward-Euler step (ImplicitEuler, Newton + CHOLMOD) of a box clamped at x = 0 under
 // gravity, starting from rest each time: wall time per step and tets/s. The symbolic analysis of
 // the linear solver happens in an untimed warm-up step; the timed steps reuse it like a running
-// simulation. CHOLMOD's BLAS threads are not limited by ThreadLimit. Names:
+// simulation. Threads follow strata's process policy (TBB at <n>, CHOLMOD's BLAS and OpenMP at
+// 1). Names:
 // implicit_euler_step/<model>/tets:<#T>/threads:<n>.
 #include <benchmark/benchmark.h>
 
 #include <strata/core/common/parallel.hpp>
 #include <strata/core/fem/lumped_mass.hpp>
 #include <strata/core/sim/dirichlet.hpp>
-#include <strata/core/sim/dynamics_system.hpp>
 #include <strata/core/sim/implicit_euler.hpp>
 #include <strata/core/sim/loads.hpp>
+#include <strata/core/sim/problem.hpp>
 #include <strata/core/sim/region.hpp>
 #include <strata/core/sim/solver_settings.hpp>
 
@@ -21,7 +22,7 @@ namespace {
 
 void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialModel material,
                              int threads) {
-  const ThreadLimit limit(threads);
+  set_thread_policy({.threads = threads});
   const ModelCase& c = model_case(size, material);
   const ElasticModel& model = *c.model;
   const Material& mat = model.material();
@@ -44,17 +45,17 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
 
   const SolverSettings settings;
   const EmbeddedElasticModel embedded(model);
-  const DynamicsSystem system{embedded,
-                              dof_mass,
-                              f_ext,
-                              mat.mass_damping,
-                              mat.stiffness_damping,
-                              groups,
-                              constrained,
-                              /*ramp_time=*/1.0,
-                              (hi - lo).norm()};
-  ImplicitEuler stepper(system, LinearSolverKind::cholmod, settings.max_newton_iterations,
-                        settings.newton_tolerance);
+  const Problem problem{.model = embedded,
+                        .dof_mass = dof_mass,
+                        .external_forces = f_ext,
+                        .groups = groups,
+                        .constrained = constrained,
+                        .mass_damping = mat.mass_damping,
+                        .stiffness_damping = mat.stiffness_damping,
+                        .ramp_time = 1.0,
+                        .diagonal = (hi - lo).norm()};
+  ImplicitEuler stepper(problem, LinearSolverKind::cholmod,
+                        {settings.max_newton_iterations, settings.newton_tolerance});
 
   const VectorXd rest = model.rest_positions();
   VectorXd x = rest;

@@ -11,6 +11,7 @@
 #include "strata/app/scene_parser.hpp"
 #include "strata/app/scene_runner.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/io/mesh_io.hpp"
 #include "strata/core/mesh/mesh_quality.hpp"
 #include "strata/meshing/mesh_level_set.hpp"
@@ -88,6 +89,11 @@ int main(int argc, char** argv) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   run->add_flag("-q,--quiet", quiet, "No progress bar, info lines or summary");
+  int threads = 0;
+  run->add_option("--threads", threads,
+                  "Threads of strata's parallel loops (default 0: every core); the BLAS and "
+                  "OpenMP threads of the sparse solver stay at 1 so that nothing oversubscribes")
+      ->check(CLI::NonNegativeNumber);
 
   CLI::App* info = app.add_subcommand("info", "Print counts, volume and quality of a tet mesh");
   std::string info_file;
@@ -142,6 +148,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    strata::set_thread_policy({.threads = threads});
     if (*run) {
       const strata::app::Scene scene = strata::app::load_scene(scene_file, overrides);
       strata::app::RunOptions options;

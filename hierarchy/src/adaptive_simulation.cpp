@@ -1,5 +1,6 @@
 #include "strata/hierarchy/adaptive_simulation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,6 +54,11 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.newton_iterations += b.newton_iterations;
   a.element_evaluations += b.element_evaluations;
   a.factorizations += b.factorizations;
+  a.exact_hessian_iterations += b.exact_hessian_iterations;
+  a.projected_hessian_iterations += b.projected_hessian_iterations;
+  a.increment_converged_steps += b.increment_converged_steps;
+  a.stalled_steps += b.stalled_steps;
+  a.max_residual_ratio = std::max(a.max_residual_ratio, b.max_residual_ratio);
   return a;
 }
 

@@ -2,8 +2,7 @@
 
 namespace strata {
 
-void symplectic_euler_step(const DynamicsSystem& system, double t, double h, VectorXd& x,
-                           VectorXd& v) {
+void symplectic_euler_step(const Problem& system, double t, double h, VectorXd& x, VectorXd& v) {
   VectorXd a;
   system.accelerations(t, x, v, a);
   v += h * a;
@@ -11,7 +10,7 @@ void symplectic_euler_step(const DynamicsSystem& system, double t, double h, Vec
   system.apply_constraints(t + h, x, v);
 }
 
-void rk4_step(const DynamicsSystem& system, double t, double h, VectorXd& x, VectorXd& v) {
+void rk4_step(const Problem& system, double t, double h, VectorXd& x, VectorXd& v) {
   // Stage states carry the prescribed motion at Dirichlet DOFs so stage velocities are exact.
   auto stage = [&](double time, VectorXd xs, VectorXd vs, VectorXd& dx, VectorXd& dv) {
     system.apply_constraints(time, xs, vs);

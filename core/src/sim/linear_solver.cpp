@@ -14,6 +14,9 @@ struct SpdSolver::Impl {
 
 SpdSolver::SpdSolver(LinearSolverKind kind) : m_impl(std::make_unique<Impl>()), m_kind(kind) {
   m_impl->cg.setTolerance(1e-12);
+  // A failed factorisation is an expected outcome (Newton then projects the Hessian): no
+  // CHOLMOD warning on stderr.
+  m_impl->cholmod.cholmod().print = 0;
 }
 
 SpdSolver::~SpdSolver() = default;

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "strata/core/sim/stable_time_step.hpp"
-
 namespace strata {
 
 namespace {
@@ -26,7 +24,48 @@ bool solve_with_shift(SpdSolver& solver, SparseMatrixd& H, const VectorXd& rhs, 
   return false;
 }
 
+double displacement_scale(const NewtonSettings& settings, const VectorXd& q) {
+  const double scale = settings.rest_positions != nullptr
+                           ? (q - *settings.rest_positions).lpNorm<Eigen::Infinity>()
+                           : q.lpNorm<Eigen::Infinity>();
+  return std::max(scale, settings.step_tolerance);
+}
+
+/// Chooses the Hessian of each iteration: exact first, projected where the exact one is not
+/// positive definite, with an exponential back-off before the exact one is tried again.
+class HessianChoice {
+ public:
+  explicit HessianChoice(bool exact_allowed) : m_exact_allowed(exact_allowed) {}
+  bool try_exact() const { return m_exact_allowed && m_skip == 0; }
+  void exact_failed() {
+    m_backoff = std::max(1, 2 * m_backoff);
+    m_skip = m_backoff;
+  }
+  void iteration_done() {
+    if (m_skip > 0) --m_skip;
+  }
+
+ private:
+  bool m_exact_allowed;
+  int m_backoff = 0;
+  int m_skip = 0;
+};
+
 }  // namespace
+
+std::string to_string(NewtonCriterion criterion) {
+  switch (criterion) {
+    case NewtonCriterion::residual:
+      return "residual";
+    case NewtonCriterion::increment:
+      return "increment";
+    case NewtonCriterion::stall:
+      return "stall";
+    case NewtonCriterion::none:
+      break;
+  }
+  return "none";
+}
 
 double internal_force_roundoff(const EmbeddedElasticModel& model) {
   const LameParameters lame = model.material().lame();
@@ -35,7 +74,7 @@ double internal_force_roundoff(const EmbeddedElasticModel& model) {
          std::sqrt(static_cast<double>(model.num_dofs()));
 }
 
-NewtonResult newton_minimize(const NewtonObjective& objective, const DofReduction& reduction,
+NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& reduction,
                              SpdSolver& solver, const NewtonSettings& settings, VectorXd& x) {
   NewtonResult result;
   VectorXd gradient(x.size()), trial_gradient(x.size());
@@ -44,27 +83,48 @@ NewtonResult newton_minimize(const NewtonObjective& objective, const DofReductio
   objective.gradient(x, gradient);
   VectorXd g = reduction.restrict_vector(gradient);
   result.residual = g.norm();
-  double energy = objective.energy(x);
+  result.residuals.push_back(result.residual);
+  double energy = objective.value(x);
   const double target =
       std::max(settings.tolerance * settings.force_scale, settings.residual_floor);
+  result.residual_target = target;
+  HessianChoice choice(settings.exact_hessian && solver.kind() == LinearSolverKind::cholmod);
+  auto finish = [&](NewtonCriterion criterion) {
+    result.converged = true;
+    result.criterion = criterion;
+    return result;
+  };
   while (true) {
-    if (result.residual <= target || reduction.num_free() == 0) {
-      result.converged = true;
-      return result;
-    }
+    if (result.residual <= target || reduction.num_free() == 0)
+      return finish(NewtonCriterion::residual);
     if (result.iterations >= settings.max_iterations) return result;
     ++result.iterations;
 
-    objective.hessian(x, hessian);
-    reduction.restrict_matrix(hessian, reduced_hessian);
-    if (!solve_with_shift(solver, reduced_hessian, -g, step)) return result;
+    bool solved = false;
+    if (choice.try_exact()) {
+      objective.hessian(x, hessian, false);
+      reduction.restrict_matrix(hessian, reduced_hessian);
+      solved = solver.solve(reduced_hessian, -g, step);
+      if (solved)
+        ++result.exact_hessian_iterations;
+      else
+        choice.exact_failed();
+    }
+    if (!solved) {
+      objective.hessian(x, hessian, true);
+      reduction.restrict_matrix(hessian, reduced_hessian);
+      if (!solve_with_shift(solver, reduced_hessian, -g, step)) return result;
+      ++result.projected_hessian_iterations;
+    }
+    choice.iteration_done();
     VectorXd full_step = VectorXd::Zero(x.size());
     reduction.add_prolonged(step, full_step);
+    const double increment = full_step.lpNorm<Eigen::Infinity>();
 
     const double slope = g.dot(step);
     double alpha = 1.0;
     VectorXd trial = x + full_step;
-    double trial_energy = objective.energy(trial);
+    double trial_energy = objective.value(trial);
     objective.gradient(trial, trial_gradient);
     VectorXd trial_g = reduction.restrict_vector(trial_gradient);
     // Near convergence the predicted energy change falls below E's round-off: decide by the
@@ -77,7 +137,7 @@ NewtonResult newton_minimize(const NewtonObjective& objective, const DofReductio
     while (!accepted && !energy_is_noise && alpha > 1e-10) {
       alpha *= 0.5;
       trial = x + alpha * full_step;
-      trial_energy = objective.energy(trial);
+      trial_energy = objective.value(trial);
       accepted = std::isfinite(trial_energy) && trial_energy <= energy + 1e-4 * alpha * slope;
       if (accepted) {
         objective.gradient(trial, trial_gradient);
@@ -88,20 +148,26 @@ NewtonResult newton_minimize(const NewtonObjective& objective, const DofReductio
       // Backtracking failed (E flat to round-off along Δ): take the full step if it lowers ‖g‖.
       alpha = 1.0;
       trial = x + full_step;
-      trial_energy = objective.energy(trial);
+      trial_energy = objective.value(trial);
       objective.gradient(trial, trial_gradient);
       trial_g = reduction.restrict_vector(trial_gradient);
-      if (!(std::isfinite(trial_energy) && trial_g.norm() < result.residual)) return result;
+      if (!(std::isfinite(trial_energy) && trial_g.norm() < result.residual)) {
+        // Nothing lowers E or ‖g‖: converged if the correction is at round-off level.
+        if (increment <= settings.stall_tolerance * displacement_scale(settings, x))
+          return finish(NewtonCriterion::stall);
+        return result;
+      }
     }
 
     x = trial;
     energy = trial_energy;
     g = trial_g;
     result.residual = g.norm();
-    if (full_step.lpNorm<Eigen::Infinity>() <= settings.step_tolerance) {
-      result.converged = true;
-      return result;
-    }
+    result.residuals.push_back(result.residual);
+    if (result.residual <= target) return finish(NewtonCriterion::residual);
+    if (increment <= settings.step_tolerance) return finish(NewtonCriterion::increment);
+    if (alpha == 1.0 && increment <= settings.increment_tolerance * displacement_scale(settings, x))
+      return finish(NewtonCriterion::increment);
   }
 }
 

@@ -1,14 +1,15 @@
 #include "strata/core/sim/simulation.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/fem/lumped_mass.hpp"
-#include "strata/core/sim/dynamics_system.hpp"
 #include "strata/core/sim/explicit_integrators.hpp"
 #include "strata/core/sim/implicit_euler.hpp"
+#include "strata/core/sim/problem.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
 #include "strata/core/sim/static_solver.hpp"
 
@@ -95,20 +96,26 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   m_v = VectorXd::Zero(m_x.size());
   m_x_previous = m_x;
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
-  m_system.reset(new DynamicsSystem{*m_embedded, m_dof_mass, m_external, m_material.mass_damping,
-                                    m_material.stiffness_damping, m_groups, m_constrained,
-                                    ramp_time, m_diagonal});
+  m_system.reset(new Problem{.model = *m_embedded,
+                             .dof_mass = m_dof_mass,
+                             .external_forces = m_external,
+                             .groups = m_groups,
+                             .constrained = m_constrained,
+                             .mass_damping = m_material.mass_damping,
+                             .stiffness_damping = m_material.stiffness_damping,
+                             .ramp_time = ramp_time,
+                             .diagonal = m_diagonal,
+                             .ground = m_ground ? &*m_ground : nullptr,
+                             .ground_stiffness = m_ground_stiffness});
+  const NewtonControls newton{m_settings.max_newton_iterations, m_settings.newton_tolerance,
+                              m_settings.exact_hessian};
   if (is_static(m_settings)) {
-    m_static = std::make_unique<StaticSolver>(
-        *m_embedded, m_external, m_groups, m_constrained, m_ground, m_ground_stiffness,
-        m_settings.linear_solver, m_settings.max_newton_iterations, m_settings.newton_tolerance);
+    m_static = std::make_unique<StaticSolver>(*m_system, m_settings.linear_solver, newton);
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), 0.0, m_x, m_v);
     m_v.setZero();
   } else {
     if (m_settings.integrator == Integrator::implicit_euler)
-      m_implicit = std::make_unique<ImplicitEuler>(*m_system, m_settings.linear_solver,
-                                                   m_settings.max_newton_iterations,
-                                                   m_settings.newton_tolerance);
+      m_implicit = std::make_unique<ImplicitEuler>(*m_system, m_settings.linear_solver, newton);
     m_system->apply_constraints(time(), m_x, m_v);
   }
   update_mesh_state();
@@ -187,7 +194,7 @@ void Simulation::advance_dynamic() {
       break;
     case Integrator::implicit_euler: {
       const NewtonResult result = m_implicit->step(t, h, m_x, m_v);
-      m_newton_iterations += result.iterations;
+      record_newton(result);
       if (!result.converged)
         throw_newton_failure("implicit_euler", result.iterations, result.residual);
       break;
@@ -206,7 +213,7 @@ void Simulation::resolve_static() {
   const double lambda = load_factor();
   VectorXd guess = m_x;
   const NewtonResult result = m_static->solve(lambda, guess);
-  m_newton_iterations += result.iterations;
+  record_newton(result);
   if (!result.converged)
     throw DivergenceError("static: Newton did not converge re-solving load step " +
                               std::to_string(m_steps) + ", load factor " + std::to_string(lambda) +
@@ -226,7 +233,7 @@ void Simulation::advance_static() {
   if (m_steps > m_first_step)
     guess += m_x - m_x_previous;  // linear extrapolation along the load path
   const NewtonResult result = m_static->solve(lambda, guess);
-  m_newton_iterations += result.iterations;
+  record_newton(result);
   if (!result.converged) throw_newton_failure("static", result.iterations, result.residual);
   m_x_previous = m_x;
   m_x = guess;
@@ -278,10 +285,21 @@ double Simulation::external_potential_energy() const {
   return -scale * m_external.dot(m_x - m_embedded->rest_positions());
 }
 
+void Simulation::record_newton(const NewtonResult& result) {
+  m_newton.newton_iterations += result.iterations;
+  m_newton.exact_hessian_iterations += result.exact_hessian_iterations;
+  m_newton.projected_hessian_iterations += result.projected_hessian_iterations;
+  if (!result.converged) return;
+  if (result.criterion == NewtonCriterion::increment) ++m_newton.increment_converged_steps;
+  if (result.criterion == NewtonCriterion::stall) ++m_newton.stalled_steps;
+  if (result.residual_target > 0.0)
+    m_newton.max_residual_ratio =
+        std::max(m_newton.max_residual_ratio, result.residual / result.residual_target);
+}
+
 SimulationCounters Simulation::counters() const {
-  SimulationCounters counters;
+  SimulationCounters counters = m_newton;
   counters.steps = m_steps - m_first_step;
-  counters.newton_iterations = m_newton_iterations;
   counters.element_evaluations = m_model->element_evaluations();
   if (m_implicit) counters.factorizations = m_implicit->linear_solver().factorizations();
   if (m_static) counters.factorizations = m_static->linear_solver().factorizations();

@@ -2,68 +2,60 @@
 
 #include <algorithm>
 
+#include "strata/core/sim/energy/elastic_term.hpp"
+#include "strata/core/sim/energy/ground_penalty_term.hpp"
+
 namespace strata {
 
-StaticSolver::StaticSolver(const EmbeddedElasticModel& model, const VectorXd& external_forces,
-                           const std::vector<DirichletGroup>& groups,
-                           const std::vector<char>& constrained,
-                           const std::optional<GroundPlane>& ground, double ground_stiffness,
-                           LinearSolverKind solver, int max_newton_iterations,
-                           double newton_tolerance)
-    : m_model(model),
-      m_external_forces(external_forces),
-      m_groups(groups),
-      m_ground(ground),
-      m_ground_stiffness(ground_stiffness),
+StaticSolver::StaticSolver(const Problem& problem, LinearSolverKind solver, NewtonControls controls)
+    : m_problem(problem),
       m_solver(solver),
-      m_reduction(model.stiffness_pattern(), constrained),
-      m_max_iterations(max_newton_iterations),
-      m_tolerance(newton_tolerance) {}
-
-double StaticSolver::potential(double load_factor, const VectorXd& x) const {
-  double e = m_model.energy(x) - load_factor * m_external_forces.dot(x);
-  if (m_ground) e += ground_penalty_energy(*m_ground, m_ground_stiffness, x);
-  return e;
+      m_reduction(problem.model.stiffness_pattern(), problem.constrained),
+      m_controls(controls),
+      m_energy(problem.model.stiffness_pattern()) {
+  m_energy.emplace<ElasticTerm>(problem.model);
+  m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
+  if (problem.ground != nullptr)
+    m_ground = &m_energy.emplace<GroundPenaltyTerm>(*problem.ground, problem.ground_stiffness);
 }
 
-VectorXd StaticSolver::contact_forces(const VectorXd& x) const {
-  VectorXd gradient = VectorXd::Zero(x.size());
-  if (m_ground) add_ground_penalty_gradient(*m_ground, m_ground_stiffness, x, gradient);
+double StaticSolver::potential(double load_factor, const VectorXd& q) {
+  m_external->set_load_factor(load_factor);
+  return m_energy.value(q);
+}
+
+VectorXd StaticSolver::contact_forces(const VectorXd& q) const {
+  VectorXd gradient = VectorXd::Zero(q.size());
+  if (m_ground != nullptr) m_ground->add_gradient(q, gradient);
   return -gradient;
 }
 
-NewtonResult StaticSolver::solve(double load_factor, VectorXd& x) {
+NewtonResult StaticSolver::solve(double load_factor, VectorXd& q) {
   const double lambda = load_factor;
-  auto energy = [&](const VectorXd& y) { return potential(lambda, y); };
-  auto gradient = [&](const VectorXd& y, VectorXd& g) {
-    VectorXd f_int;
-    m_model.forces(y, f_int);
-    g = -f_int - lambda * m_external_forces;
-    if (m_ground) add_ground_penalty_gradient(*m_ground, m_ground_stiffness, y, g);
-  };
-  auto hessian = [&](const VectorXd& y, SparseMatrixd& H) {
-    m_model.stiffness(y, H, true);
-    if (m_ground) add_ground_penalty_hessian(*m_ground, m_ground_stiffness, y, H);
-  };
+  const EmbeddedElasticModel& model = m_problem.model;
+  m_external->set_load_factor(lambda);
 
-  VectorXd unused_velocity = VectorXd::Zero(x.size());
-  apply_dirichlet(m_groups, m_model.rest_positions(), lambda, 0.0, x, unused_velocity);
+  VectorXd unused_velocity = VectorXd::Zero(q.size());
+  apply_dirichlet(m_problem.groups, model.rest_positions(), lambda, 0.0, q, unused_velocity);
 
   VectorXd f_int;
-  m_model.forces(x, f_int);
+  model.forces(q, f_int);
+  const VectorXd& f_ext = m_problem.external_forces;
   NewtonSettings settings;
-  settings.max_iterations = m_max_iterations;
-  settings.tolerance = m_tolerance;
-  settings.force_scale = std::max((lambda * m_external_forces).norm(), f_int.norm());
-  settings.residual_floor = internal_force_roundoff(m_model);
-  const VectorXd& rest = m_model.rest_positions();
+  settings.max_iterations = m_controls.max_iterations;
+  settings.tolerance = m_controls.tolerance;
+  settings.exact_hessian = m_controls.exact_hessian;
+  settings.force_scale = std::max((lambda * f_ext).norm(), f_int.norm());
+  settings.residual_floor = internal_force_roundoff(model);
+  const VectorXd& rest = model.rest_positions();
   const double size =
       (unflatten(rest).colwise().maxCoeff() - unflatten(rest).colwise().minCoeff()).norm();
   settings.step_tolerance = 1e-14 * size;
-  const LameParameters lame = m_model.material().lame();
-  settings.energy_scale = (2 * lame.mu + lame.lambda) * m_model.total_rest_volume() +
-                          std::abs(lambda * m_external_forces.dot(x));
-  return newton_minimize({energy, gradient, hessian}, m_reduction, m_solver, settings, x);
+  settings.rest_positions = &rest;
+  const LameParameters lame = model.material().lame();
+  settings.energy_scale =
+      (2 * lame.mu + lame.lambda) * model.total_rest_volume() + std::abs(lambda * f_ext.dot(q));
+  return newton_minimize(m_energy, m_reduction, m_solver, settings, q);
 }
 
 }  // namespace strata

@@ -174,7 +174,7 @@ DirichletSpec parse_prescribed(const SceneValue& value) {
 
 SolverSettings parse_solver(const SceneValue& value) {
   value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "linear_solver",
-                       "newton_tolerance", "max_newton_iterations"});
+                       "newton_tolerance", "max_newton_iterations", "hessian"});
   SolverSettings solver;
   solver.mode = static_cast<SimulationMode>(value.at("mode").choice({"dynamic", "static"}));
   if (value.has("integrator")) {
@@ -199,6 +199,8 @@ SolverSettings parse_solver(const SceneValue& value) {
   if (value.has("max_newton_iterations")) {
     solver.max_newton_iterations = value.at("max_newton_iterations").integer(1);
   }
+  if (value.has("hessian"))
+    solver.exact_hessian = value.at("hessian").choice({"projected", "exact_where_pd"}) == 1;
   return solver;
 }
 

@@ -15,6 +15,7 @@
 #include "strata/app/run_outputs.hpp"
 #include "strata/app/vtk_series.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
@@ -139,6 +140,18 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   stats["newton_iterations"] = counters.newton_iterations;
   stats["element_evaluations"] = counters.element_evaluations;
   stats["factorizations"] = counters.factorizations;
+  stats["newton"] = {{"exact_hessian_iterations", counters.exact_hessian_iterations},
+                     {"projected_hessian_iterations", counters.projected_hessian_iterations},
+                     {"increment_converged_steps", counters.increment_converged_steps},
+                     {"stalled_steps", counters.stalled_steps},
+                     {"max_residual_ratio", counters.max_residual_ratio}};
+  if (counters.stalled_steps > 0)
+    stats["newton"]["note"] = std::to_string(counters.stalled_steps) +
+                              " Newton solve(s) stopped with the residual stalled at round-off "
+                              "(up to " +
+                              std::to_string(counters.max_residual_ratio) +
+                              " x the residual target) and were accepted as converged";
+  stats["threads"] = max_threads();
   stats["vertices"] = simulation.mesh().vertices.rows();
   stats["tets"] = simulation.mesh().tets.rows();
   stats["dofs"] = simulation.embedded_model().num_dofs();

@@ -1,7 +1,10 @@
 #pragma once
 /// \file parallel.hpp
-/// Thread control for strata's TBB loops. By default TBB uses every core; tests and benchmarks can
-/// force a count.
+/// Thread control. strata's own loops run on TBB; the BLAS behind CHOLMOD (OpenBLAS) and OpenMP
+/// start threads of their own. On few cores these oversubscribe them: BLAS and OpenMP threads
+/// spin-wait while TBB's workers run and the reverse, which shows as system time. One process-wide
+/// policy (`set_thread_policy`) sets all three: TBB to N threads, BLAS and OpenMP to
+/// `ThreadPolicy::blas_threads` (default 1, so the sparse factorisation does not compete with TBB).
 #include <memory>
 
 namespace strata {
@@ -21,5 +24,24 @@ class ThreadLimit {
 
 /// Number of threads TBB will currently use.
 int max_threads();
+
+/// Number of cores this process may run on (its CPU affinity mask; at least 1).
+int available_cores();
+
+struct ThreadPolicy {
+  int threads = 0;       ///< TBB threads; 0 = available_cores()
+  int blas_threads = 1;  ///< OpenBLAS and OpenMP threads (0 = same as `threads`)
+};
+
+/// What the policy set. A library that is not loaded (or not OpenBLAS / not OpenMP) reports 0.
+struct ThreadReport {
+  int threads = 0;
+  int blas_threads = 0;
+  int openmp_threads = 0;
+};
+
+/// Applies `policy` for the rest of the process (replacing an earlier one). Throws InputError for
+/// negative counts.
+ThreadReport set_thread_policy(const ThreadPolicy& policy);
 
 }  // namespace strata

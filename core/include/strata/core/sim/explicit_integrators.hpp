@@ -1,20 +1,19 @@
 #pragma once
 /// \file explicit_integrators.hpp
-/// Explicit time steps of the DynamicsSystem. Both are conditionally stable: dt must stay below
+/// Explicit time steps of the Problem. Both are conditionally stable: dt must stay below
 /// roughly the CFL estimate (stable_time_step.hpp); a violation blows up and is caught by
 /// check_divergence. Dirichlet DOFs are set to their targets at the end of the step.
 #include "strata/core/common/types.hpp"
-#include "strata/core/sim/dynamics_system.hpp"
+#include "strata/core/sim/problem.hpp"
 
 namespace strata {
 
 /// Symplectic (semi-implicit) Euler from time t: v ← v + h a(x, v), then x ← x + h v.
 /// One force evaluation per step; energy oscillates without secular drift.
-void symplectic_euler_step(const DynamicsSystem& system, double t, double h, VectorXd& x,
-                           VectorXd& v);
+void symplectic_euler_step(const Problem& system, double t, double h, VectorXd& x, VectorXd& v);
 
 /// Classical fourth-order Runge–Kutta on (x, v)' = (v, a(x, v)) from time t; the Dirichlet DOFs'
 /// stage velocities and accelerations are the prescribed ones at each stage time.
-void rk4_step(const DynamicsSystem& system, double t, double h, VectorXd& x, VectorXd& v);
+void rk4_step(const Problem& system, double t, double h, VectorXd& x, VectorXd& v);
 
 }  // namespace strata

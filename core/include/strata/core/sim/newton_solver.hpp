@@ -1,28 +1,36 @@
 #pragma once
 /// \file newton_solver.hpp
-/// Newton's method with backtracking line search for minimising a potential E(x) over the free
-/// DOFs of a 3·#V vector (Dirichlet DOFs keep their values). Used by backward Euler (incremental
+/// Newton's method with backtracking line search for minimising a sum of energy terms E(q) over
+/// the free DOFs (Dirichlet DOFs keep their values). Used by backward Euler (incremental
 /// potential) and static equilibrium (total potential energy).
-#include <functional>
+///
+/// Hessian: the exact Hessian where it is positive definite — tried first, so Newton converges
+/// quadratically near a stable equilibrium — and the PSD-projected one (per element) where the
+/// exact factorisation fails; after a failure the exact Hessian is skipped for 1, 2, 4, …
+/// iterations before it is tried again. Iterative linear solvers (CG) use the projected Hessian
+/// only, since CG cannot detect indefiniteness.
+///
+/// Convergence, whichever comes first:
+///   - residual: ‖g_free‖ ≤ max(tolerance · force_scale, residual_floor);
+///   - increment: a full Newton step (α = 1) with ‖Δq‖∞ ≤ increment_tolerance · displacement
+///     scale, where the scale is ‖q − q_rest‖∞ (at least step_tolerance);
+///   - stall at round-off: the line search cannot lower E and the full step cannot lower ‖g‖, while
+///     ‖Δq‖∞ ≤ stall_tolerance · displacement scale — the residual is at its round-off level.
+/// The last two are reported (`NewtonResult::criterion`) with the final residual.
+#include <string>
+#include <vector>
 
 #include "strata/core/common/types.hpp"
-#include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/dof_reduction.hpp"
+#include "strata/core/sim/embedded_model.hpp"
+#include "strata/core/sim/energy/energy_term.hpp"
 #include "strata/core/sim/linear_solver.hpp"
 
 namespace strata {
 
-/// The potential to minimise. `hessian` must be symmetric positive semi-definite (project element
-/// Hessians) and keep one fixed sparsity pattern: the one the DofReduction was built for.
-struct NewtonObjective {
-  std::function<double(const VectorXd& x)> energy;                      ///< E(x); +inf if invalid
-  std::function<void(const VectorXd& x, VectorXd& gradient)> gradient;  ///< ∂E/∂x, 3·#V
-  std::function<void(const VectorXd& x, SparseMatrixd& hessian)> hessian;  ///< ∂²E/∂x², full
-};
-
 struct NewtonSettings {
   int max_iterations = 50;
-  double tolerance = 1e-10;  ///< stop when ‖g_free‖ ≤ max(tolerance · force_scale, residual_floor)
+  double tolerance = 1e-10;  ///< residual tolerance relative to force_scale
   double force_scale = 1.0;  ///< [N]
   /// Round-off level of the gradient [N] (see internal_force_roundoff); below it no iteration can
   /// make progress.
@@ -31,14 +39,31 @@ struct NewtonSettings {
   /// the predicted decrease |gᵀΔ| is below 10⁻¹¹ × max(|E|, energy_scale), E cannot resolve it and
   /// the step is judged by the gradient norm instead.
   double energy_scale = 0.0;
-  /// Also stop when the (full) Newton step is at round-off level: ‖Δx‖∞ ≤ step_tolerance [m].
+  /// Absolute floor of the displacement scale [m] (round-off of positions, e.g. 10⁻¹⁴ × size).
   double step_tolerance = 0.0;
+  /// Increment criterion relative to the displacement scale (0 disables it).
+  double increment_tolerance = 1e-9;
+  /// Largest relative increment at which a stalled residual counts as converged.
+  double stall_tolerance = 1e-7;
+  /// Try the exact Hessian first (direct solvers only).
+  bool exact_hessian = true;
+  /// Rest positions q_rest (3·#Q) for the displacement scale; empty: the scale is ‖q‖∞.
+  const VectorXd* rest_positions = nullptr;
 };
+
+/// How a Newton solve ended.
+enum class NewtonCriterion { none, residual, increment, stall };
+std::string to_string(NewtonCriterion criterion);  ///< "none" | "residual" | "increment" | "stall"
 
 struct NewtonResult {
   bool converged = false;
+  NewtonCriterion criterion = NewtonCriterion::none;
   int iterations = 0;
-  double residual = 0.0;  ///< final ‖g_free‖ [N]
+  int exact_hessian_iterations = 0;      ///< iterations solved with the exact Hessian
+  int projected_hessian_iterations = 0;  ///< … with the PSD-projected one
+  double residual = 0.0;                 ///< final ‖g_free‖ [N]
+  double residual_target = 0.0;          ///< the residual criterion's bound [N]
+  std::vector<double> residuals;         ///< ‖g_free‖ at the start and after each iteration [N]
 };
 
 /// Round-off level of the elastic forces of `model` near the rest state [N]:
@@ -46,12 +71,12 @@ struct NewtonResult {
 /// of F ≈ I times a face area, accumulated over the DOFs.
 double internal_force_roundoff(const EmbeddedElasticModel& model);
 
-/// Minimises from the initial guess `x` (3·#V, updated in place). Each iteration: gradient,
-/// Hessian, reduce to free DOFs, solve H Δ = −g (on failure, retry with a growing diagonal shift),
-/// then backtrack α = 1, ½, ¼, ... until E(x + αΔ) ≤ E(x) + 10⁻⁴ α gᵀΔ. When the decrease is
-/// below E's round-off (see energy_scale) or backtracking fails, the full step is taken if it
-/// lowers ‖g_free‖; otherwise Newton stops unconverged.
-NewtonResult newton_minimize(const NewtonObjective& objective, const DofReduction& reduction,
-                             SpdSolver& solver, const NewtonSettings& settings, VectorXd& x);
+/// Minimises `energy` from the initial guess `q` (3·#Q, updated in place). Each iteration:
+/// gradient, Hessian (exact, else projected), reduce to free DOFs, solve H Δ = −g (on failure of
+/// the projected system, retry with a growing diagonal shift), then backtrack α = 1, ½, ¼, ...
+/// until E(q + αΔ) ≤ E(q) + 10⁻⁴ α gᵀΔ. When the decrease is below E's round-off (see
+/// energy_scale) or backtracking fails, the full step is taken if it lowers ‖g_free‖.
+NewtonResult newton_minimize(const EnergySum& energy, const DofReduction& reduction,
+                             SpdSolver& solver, const NewtonSettings& settings, VectorXd& q);
 
 }  // namespace strata

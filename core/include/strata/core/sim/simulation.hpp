@@ -37,7 +37,8 @@
 
 namespace strata {
 
-struct DynamicsSystem;
+struct Problem;
+struct NewtonResult;
 class ImplicitEuler;
 class StaticSolver;
 
@@ -67,10 +68,19 @@ struct SimulationOptions {
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
 struct SimulationCounters {
-  long steps = 0;                     ///< time or load steps taken
-  long newton_iterations = 0;         ///< over all implicit / static steps
-  long long element_evaluations = 0;  ///< from ElasticModel
-  long factorizations = 0;            ///< numeric factorisations (or CG setups)
+  long steps = 0;                         ///< time or load steps taken
+  long newton_iterations = 0;             ///< over all implicit / static steps
+  long long element_evaluations = 0;      ///< from ElasticModel
+  long factorizations = 0;                ///< numeric factorisations (or CG setups)
+  long exact_hessian_iterations = 0;      ///< Newton iterations on the exact Hessian
+  long projected_hessian_iterations = 0;  ///< … on the PSD-projected Hessian
+  /// Newton solves (time or load steps) that converged on the increment, and that stopped at a
+  /// residual stalled at round-off (newton_solver.hpp); both are converged.
+  long increment_converged_steps = 0;
+  long stalled_steps = 0;
+  /// Largest final ‖residual‖ / residual target over the Newton solves (≤ 1 unless a solve
+  /// converged on the increment or stalled).
+  double max_residual_ratio = 0.0;
 };
 
 class Simulation {
@@ -170,7 +180,7 @@ class Simulation {
   double m_diagonal = 0.0;
   double m_stable_dt = 0.0;
   DivergenceLimits m_limits;
-  std::unique_ptr<DynamicsSystem> m_system;
+  std::unique_ptr<Problem> m_system;
   std::unique_ptr<ImplicitEuler> m_implicit;
   std::unique_ptr<StaticSolver> m_static;
 
@@ -181,7 +191,8 @@ class Simulation {
   VectorXd m_mesh_v;
   long m_first_step = 0;
   long m_steps = 0;
-  long m_newton_iterations = 0;
+  SimulationCounters m_newton;  ///< Newton fields only
+  void record_newton(const NewtonResult& result);
 };
 
 }  // namespace strata

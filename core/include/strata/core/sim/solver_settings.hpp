@@ -24,6 +24,9 @@ struct SolverSettings {
   /// Newton stops when ‖∇E‖ over the free DOFs ≤ tolerance × force scale (static: the applied
   /// external load, or the internal forces of the first guess when there is no load).
   double newton_tolerance = 1e-10;
+  /// Newton's Hessian: exact where positive definite, else PSD-projected (true); or always
+  /// projected (false). Scene: solver.hessian = "exact_where_pd" | "projected".
+  bool exact_hessian = true;
   /// Ground penalty stiffness factor (static mode), see ground_penalty_stiffness.
   double contact_stiffness_factor = 100.0;
 };

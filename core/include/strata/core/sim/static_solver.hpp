@@ -1,52 +1,53 @@
 #pragma once
 /// \file static_solver.hpp
 /// Quasi-static equilibrium at a load factor λ ∈ (0, 1]: minimises the total potential energy
-///   Π(x) = Ψ(x) − λ f_extᵀx + Φ_ground(x)
-/// over the free DOFs, with the Dirichlet groups at ramp factor s = λ, by Newton with line search
-/// and PSD-projected element Hessians (newton_solver.hpp). Convergence: ‖∇Π‖ over the free DOFs ≤
-/// tolerance × max(‖λ f_ext‖, ‖f_int(x₀)‖) — the applied load, or for purely prescribed motion
-/// the internal forces of the initial guess x₀.
-#include <optional>
-
-#include "strata/core/sim/embedded_model.hpp"
-#include "strata/core/sim/dirichlet.hpp"
+///   Π(q) = Ψ(q) − λ f_extᵀq + Φ_ground(q)
+/// (energy terms: elastic, external work, ground penalty) over the free DOFs, with the Dirichlet
+/// groups at ramp factor s = λ, by Newton with line search (newton_solver.hpp). Residual
+/// criterion: ‖∇Π‖ over the free DOFs ≤ tolerance × max(‖λ f_ext‖, ‖f_int(q₀)‖) — the applied
+/// load, or for purely prescribed motion the internal forces of the initial guess q₀.
 #include "strata/core/sim/dof_reduction.hpp"
-#include "strata/core/sim/ground_contact.hpp"
+#include "strata/core/sim/energy/energy_term.hpp"
+#include "strata/core/sim/energy/external_work_term.hpp"
 #include "strata/core/sim/linear_solver.hpp"
 #include "strata/core/sim/newton_solver.hpp"
+#include "strata/core/sim/problem.hpp"
 
 namespace strata {
 
+/// The Newton controls a scene sets (solver.max_newton_iterations, solver.newton_tolerance).
+struct NewtonControls {
+  int max_iterations = 50;
+  double tolerance = 1e-10;
+  /// Exact Hessian where positive definite (else projected); false: always PSD-projected.
+  bool exact_hessian = true;
+};
+
 class StaticSolver {
  public:
-  /// All references must outlive this object. `ground_stiffness` [N/m] is used when `ground`
-  /// is set.
-  StaticSolver(const EmbeddedElasticModel& model, const VectorXd& external_forces,
-               const std::vector<DirichletGroup>& groups, const std::vector<char>& constrained,
-               const std::optional<GroundPlane>& ground, double ground_stiffness,
-               LinearSolverKind solver, int max_newton_iterations, double newton_tolerance);
+  /// `problem` (and what it references) must outlive this object.
+  StaticSolver(const Problem& problem, LinearSolverKind solver, NewtonControls controls);
 
-  /// Equilibrium at load factor λ starting from the initial guess `x` (3·#V; its Dirichlet DOFs
-  /// are overwritten with the targets at s = λ). `x` is updated in place.
-  NewtonResult solve(double load_factor, VectorXd& x);
+  /// Equilibrium at load factor λ starting from the initial guess `q` (3·#Q; its Dirichlet DOFs
+  /// are overwritten with the targets at s = λ). `q` is updated in place.
+  NewtonResult solve(double load_factor, VectorXd& q);
 
-  /// Total potential Π(x) at load factor λ.
-  double potential(double load_factor, const VectorXd& x) const;
-  /// Ground penalty forces −∂Φ/∂x at x (zero vector without ground).
-  VectorXd contact_forces(const VectorXd& x) const;
+  /// Total potential Π(q) at load factor λ.
+  double potential(double load_factor, const VectorXd& q);
+  /// Ground penalty forces −∂Φ/∂q at q (zero vector without ground).
+  VectorXd contact_forces(const VectorXd& q) const;
 
+  const EnergySum& energy() const { return m_energy; }
   const SpdSolver& linear_solver() const { return m_solver; }
 
  private:
-  const EmbeddedElasticModel& m_model;
-  const VectorXd& m_external_forces;
-  const std::vector<DirichletGroup>& m_groups;
-  const std::optional<GroundPlane>& m_ground;
-  double m_ground_stiffness;
+  const Problem& m_problem;
   SpdSolver m_solver;
   DofReduction m_reduction;
-  int m_max_iterations;
-  double m_tolerance;
+  NewtonControls m_controls;
+  EnergySum m_energy;
+  ExternalWorkTerm* m_external = nullptr;
+  const EnergyTerm* m_ground = nullptr;
 };
 
 }  // namespace strata

@@ -1,23 +1,23 @@
-#include "strata/core/sim/dynamics_system.hpp"
+#include "strata/core/sim/problem.hpp"
 
 #include <algorithm>
 
 namespace strata {
 
-double DynamicsSystem::ramp(double t) const {
+double Problem::ramp(double t) const {
   return std::clamp(t / ramp_time, 0.0, 1.0);
 }
 
-double DynamicsSystem::ramp_rate(double t) const {
+double Problem::ramp_rate(double t) const {
   return t < ramp_time ? 1.0 / ramp_time : 0.0;
 }
 
-void DynamicsSystem::apply_constraints(double t, VectorXd& x, VectorXd& v) const {
+void Problem::apply_constraints(double t, VectorXd& x, VectorXd& v) const {
   apply_dirichlet(groups, model.rest_positions(), ramp(t), ramp_rate(t), x, v);
 }
 
-void DynamicsSystem::add_damping_forces(const VectorXd& x, const VectorXd& v, const VectorXd& f_int,
-                                        VectorXd& f) const {
+void Problem::add_damping_forces(const VectorXd& x, const VectorXd& v, const VectorXd& f_int,
+                                 VectorXd& f) const {
   if (mass_damping > 0.0) f.array() -= mass_damping * dof_mass.array() * v.array();
   if (stiffness_damping <= 0.0) return;
   const double speed = v.lpNorm<Eigen::Infinity>();
@@ -30,8 +30,7 @@ void DynamicsSystem::add_damping_forces(const VectorXd& x, const VectorXd& v, co
   f += (stiffness_damping / epsilon) * (f_shifted - f_int);
 }
 
-void DynamicsSystem::accelerations(double t, const VectorXd& x, const VectorXd& v,
-                                   VectorXd& a) const {
+void Problem::accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const {
   VectorXd f_int;
   model.forces(x, f_int);
   VectorXd f = f_int + external_forces;

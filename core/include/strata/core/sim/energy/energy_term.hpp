@@ -1,0 +1,69 @@
+#pragma once
+/// \file energy_term.hpp
+/// One potential of a Problem, E_i(q), over the 3·#Q DOF vector: its value, gradient and Hessian
+/// (exact or PSD-projected). Newton minimises the sum of a list of terms (EnergySum) for static
+/// load steps and backward-Euler steps alike; explicit integrators use the elastic forces and the
+/// loads directly.
+///
+/// Hessians are added into a matrix in the Problem's fixed sparsity pattern (the elastic
+/// stiffness pattern, which holds every vertex's diagonal 3×3 block), so a sum of terms keeps one
+/// pattern and one symbolic factorisation.
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "strata/core/common/types.hpp"
+
+namespace strata {
+
+class EnergyTerm {
+ public:
+  virtual ~EnergyTerm() = default;
+  /// Short name for reports and tests ("elastic", "inertia", ...).
+  virtual std::string_view name() const = 0;
+  /// E(q) [J]; +inf where the term is undefined (e.g. an inverted element of a model that cannot
+  /// handle inversion).
+  virtual double value(ConstRef<VectorXd> q) const = 0;
+  /// g += ∂E/∂q (3·#Q).
+  virtual void add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const = 0;
+  /// H += ∂²E/∂q², or its PSD projection when `project_psd` (per element or per vertex, so the
+  /// sum stays PSD). H has the Problem's pattern; only its values change.
+  virtual void add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian,
+                           bool project_psd) const = 0;
+};
+
+/// A sum of energy terms, the objective Newton minimises. Terms are owned.
+class EnergySum {
+ public:
+  /// `pattern`: the sparsity pattern every Hessian is assembled into (3·#Q square, compressed).
+  explicit EnergySum(const SparseMatrixd& pattern) : m_pattern(&pattern) {}
+
+  EnergyTerm& add(std::unique_ptr<EnergyTerm> term);
+  template <typename Term, typename... Args>
+  Term& emplace(Args&&... args) {
+    return static_cast<Term&>(add(std::make_unique<Term>(std::forward<Args>(args)...)));
+  }
+
+  const std::vector<std::unique_ptr<EnergyTerm>>& terms() const { return m_terms; }
+  const SparseMatrixd& pattern() const { return *m_pattern; }
+
+  /// Σ E_i(q) [J] (+inf if any term is).
+  double value(ConstRef<VectorXd> q) const;
+  /// ∂E/∂q, resized to 3·#Q.
+  void gradient(ConstRef<VectorXd> q, VectorXd& gradient) const;
+  /// ∂²E/∂q² in the pattern (H is set to the pattern on first use, then only its values change).
+  void hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const;
+
+ private:
+  const SparseMatrixd* m_pattern;
+  std::vector<std::unique_ptr<EnergyTerm>> m_terms;
+};
+
+/// Adds `scale` · the values of `source` to those of `target`; both must have the same pattern.
+void add_values_same_pattern(const SparseMatrixd& source, double scale, SparseMatrixd& target);
+
+/// Adds `weights[i]` to the diagonal entry (i, i) of `target`, whose pattern must hold the
+/// diagonal.
+void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target);
+
+}  // namespace strata

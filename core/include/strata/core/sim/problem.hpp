@@ -1,0 +1,55 @@
+#pragma once
+/// \file problem.hpp
+/// What a scene means, bound to one mesh or active cut: the elastic model on the DOFs q (x = P q,
+/// embedded_model.hpp), lumped masses, dead loads, Rayleigh damping, Dirichlet groups and the
+/// ground. Steppers read it; the energy terms of a Newton step are built from it
+/// (`add_static_terms`, `add_implicit_euler_terms`).
+///
+/// Equations of motion (explicit integrators):
+///   M a = f_int(x) + f_ext + f_damp(x, v),   f_damp = −(α M + β K(x)) v  (Rayleigh),
+/// with lumped (diagonal) M and Dirichlet groups ramped by s(t) = min(t/T_r, 1). K(x) v is
+/// evaluated matrix-free by a one-sided finite difference of the elastic forces,
+/// K v ≈ −(f_int(x + εv) − f_int(x)) / ε with ε‖v‖∞ = 10⁻⁷ × the bounding-box diagonal (one extra
+/// force evaluation, only when β > 0).
+///
+/// Built with designated initialisers; the referenced data must outlive the Problem:
+///   Problem problem{.model = m, .dof_mass = M, .external_forces = f, .groups = g,
+///                   .constrained = c, .ramp_time = T, .diagonal = d};
+#include <vector>
+
+#include "strata/core/common/types.hpp"
+#include "strata/core/sim/dirichlet.hpp"
+#include "strata/core/sim/embedded_model.hpp"
+#include "strata/core/sim/ground_contact.hpp"
+
+namespace strata {
+
+class EnergySum;
+
+struct Problem {
+  const EmbeddedElasticModel& model;  ///< elastic forces on the DOFs q (x = P q)
+  const VectorXd& dof_mass;           ///< lumped mass per DOF, 3·#Q [kg]
+  const VectorXd& external_forces;    ///< f_ext at full load, 3·#Q [N]
+  const std::vector<DirichletGroup>& groups;
+  const std::vector<char>& constrained;  ///< 3·#Q flags
+  double mass_damping = 0.0;             ///< α [1/s]
+  double stiffness_damping = 0.0;        ///< β [s]
+  double ramp_time = 1.0;                ///< T_r [s] > 0 (dynamic ramp of prescribed motion)
+  double diagonal = 1.0;                 ///< bounding-box diagonal [m] (FD step scale)
+  const GroundPlane* ground = nullptr;   ///< optional rigid ground
+  double ground_stiffness = 0.0;         ///< penalty k [N/m] of the static ground term
+
+  /// s(t) = min(t / T_r, 1).
+  double ramp(double t) const;
+  /// ds/dt: 1/T_r while ramping, 0 after.
+  double ramp_rate(double t) const;
+  /// Writes the Dirichlet targets at time t into x and v.
+  void apply_constraints(double t, VectorXd& x, VectorXd& v) const;
+  /// Adds −(α M + β K(x)) v into `f`, K v by finite difference; `f_int` = f_int(x).
+  void add_damping_forces(const VectorXd& x, const VectorXd& v, const VectorXd& f_int,
+                          VectorXd& f) const;
+  /// a = M⁻¹ (f_int + f_ext + f_damp); at Dirichlet DOFs the prescribed acceleration at time t.
+  void accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const;
+};
+
+}  // namespace strata

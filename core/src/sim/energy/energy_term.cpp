@@ -1,0 +1,59 @@
+#include "strata/core/sim/energy/energy_term.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+EnergyTerm& EnergySum::add(std::unique_ptr<EnergyTerm> term) {
+  STRATA_VERIFY(term != nullptr, "EnergySum::add: null term");
+  m_terms.push_back(std::move(term));
+  return *m_terms.back();
+}
+
+double EnergySum::value(ConstRef<VectorXd> q) const {
+  double total = 0.0;
+  for (const auto& term : m_terms) {
+    const double e = term->value(q);
+    if (!std::isfinite(e)) return std::numeric_limits<double>::infinity();
+    total += e;
+  }
+  return total;
+}
+
+void EnergySum::gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
+  gradient.setZero(q.size());
+  for (const auto& term : m_terms)
+    term->add_gradient(q, gradient);
+}
+
+void EnergySum::hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const {
+  if (hessian.rows() != m_pattern->rows() || hessian.nonZeros() != m_pattern->nonZeros())
+    hessian = *m_pattern;
+  std::fill(hessian.valuePtr(), hessian.valuePtr() + hessian.nonZeros(), 0.0);
+  for (const auto& term : m_terms)
+    term->add_hessian(q, hessian, project_psd);
+}
+
+void add_values_same_pattern(const SparseMatrixd& source, double scale, SparseMatrixd& target) {
+  STRATA_VERIFY(source.nonZeros() == target.nonZeros() && source.rows() == target.rows(),
+                "add_values_same_pattern: patterns differ");
+  Eigen::Map<VectorXd>(target.valuePtr(), target.nonZeros()) +=
+      scale * Eigen::Map<const VectorXd>(source.valuePtr(), source.nonZeros());
+}
+
+void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target) {
+  STRATA_VERIFY(weights.size() == target.rows(), "add_diagonal: size mismatch");
+  for (Index i = 0; i < target.outerSize(); ++i) {
+    const int* begin = target.innerIndexPtr() + target.outerIndexPtr()[i];
+    const int* end = target.innerIndexPtr() + target.outerIndexPtr()[i + 1];
+    const int* found = std::lower_bound(begin, end, static_cast<int>(i));
+    STRATA_VERIFY(found != end && *found == i, "add_diagonal: pattern lacks a diagonal entry");
+    target.valuePtr()[found - target.innerIndexPtr()] += weights[i];
+  }
+}
+
+}  // namespace strata

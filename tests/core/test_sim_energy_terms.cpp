@@ -1,0 +1,180 @@
+// Energy terms of the Problem: finite-difference checks of every term's gradient (against its
+// value) and Hessian (against its gradient), exact and PSD-projected, and the EnergySum as the
+// sum of its terms.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "fem_test_utils.hpp"
+#include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/fem/lumped_mass.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/embedded_model.hpp"
+#include "strata/core/sim/energy/elastic_term.hpp"
+#include "strata/core/sim/energy/energy_term.hpp"
+#include "strata/core/sim/energy/external_work_term.hpp"
+#include "strata/core/sim/energy/ground_penalty_term.hpp"
+#include "strata/core/sim/energy/inertia_term.hpp"
+#include "strata/core/sim/energy/rayleigh_damping_term.hpp"
+
+namespace strata {
+namespace {
+
+/// A 2×1×1-cell box (12 tets) with its model, masses, loads and a deformed state.
+struct TermFixture {
+  TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.1, 0.1), {2, 1, 1});
+  Material material;
+  std::unique_ptr<ElasticModel> model;
+  std::unique_ptr<EmbeddedElasticModel> embedded;
+  VectorXd mass, forces, state, velocity;
+
+  explicit TermFixture(MaterialModel kind) {
+    material.model = kind;
+    material.youngs_modulus = 1e5;
+    material.poisson_ratio = 0.3;
+    model = std::make_unique<ElasticModel>(mesh.vertices, mesh.tets, material);
+    embedded = std::make_unique<EmbeddedElasticModel>(*model);
+    const VectorXd vertex_mass = lumped_vertex_mass(model->rest_data().rest_volume, mesh.tets,
+                                                    mesh.vertices.rows(), material.density);
+    mass.resize(model->num_dofs());
+    for (Index v = 0; v < vertex_mass.size(); ++v)
+      mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    state = model->rest_positions();
+    forces.resize(state.size());
+    velocity.resize(state.size());
+    for (Index i = 0; i < state.size(); ++i) {
+      state[i] += 0.01 * uniform(rng);
+      forces[i] = uniform(rng);
+      velocity[i] = uniform(rng);
+    }
+  }
+};
+
+/// Central differences of value and gradient at q along random directions, relative errors.
+void expect_derivatives_match(const EnergyTerm& term, const SparseMatrixd& pattern,
+                              const VectorXd& q, bool project_psd, double tolerance) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  VectorXd gradient = VectorXd::Zero(q.size());
+  term.add_gradient(q, gradient);
+  SparseMatrixd H = pattern;
+  std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
+  term.add_hessian(q, H, project_psd);
+  for (int trial = 0; trial < 3; ++trial) {
+    VectorXd direction(q.size());
+    for (Index i = 0; i < q.size(); ++i)
+      direction[i] = uniform(rng);
+    const double h = 1e-6;
+    const double fd_slope =
+        (term.value(q + h * direction) - term.value(q - h * direction)) / (2 * h);
+    const double slope = gradient.dot(direction);
+    EXPECT_NEAR(fd_slope, slope, tolerance * std::max(1.0, std::abs(slope))) << term.name();
+    if (project_psd) continue;  // the projected Hessian is not the derivative of the gradient
+    VectorXd g_plus = VectorXd::Zero(q.size()), g_minus = VectorXd::Zero(q.size());
+    term.add_gradient(q + h * direction, g_plus);
+    term.add_gradient(q - h * direction, g_minus);
+    const VectorXd fd_hessian = (g_plus - g_minus) / (2 * h);
+    const VectorXd hessian = H * direction;
+    EXPECT_LE((fd_hessian - hessian).norm(), tolerance * std::max(1.0, hessian.norm()))
+        << term.name();
+  }
+  if (project_psd) {
+    // PSD: vᵀ H v ≥ 0 for every tested direction.
+    for (int trial = 0; trial < 5; ++trial) {
+      VectorXd direction(q.size());
+      for (Index i = 0; i < q.size(); ++i)
+        direction[i] = uniform(rng);
+      EXPECT_GE(direction.dot(H * direction), -1e-9 * H.norm()) << term.name();
+    }
+  }
+}
+
+TEST(EnergyTerms, ElasticDerivativesMatchFiniteDifferences) {
+  for (MaterialModel kind : testing::kAllModels) {
+    TermFixture f(kind);
+    ElasticTerm term(*f.embedded);
+    expect_derivatives_match(term, f.embedded->stiffness_pattern(), f.state, false, 1e-5);
+    expect_derivatives_match(term, f.embedded->stiffness_pattern(), f.state, true, 1e-5);
+  }
+}
+
+TEST(EnergyTerms, InertiaDerivativesMatchFiniteDifferences) {
+  TermFixture f(MaterialModel::stvk);
+  InertiaTerm term(f.mass);
+  const double h = 1e-2;
+  term.set_step(f.model->rest_positions() + h * f.velocity, h);
+  expect_derivatives_match(term, f.embedded->stiffness_pattern(), f.state, false, 1e-6);
+  // At q = q̃ the term and its gradient vanish.
+  VectorXd gradient = VectorXd::Zero(f.state.size());
+  const VectorXd predicted = f.model->rest_positions() + h * f.velocity;
+  term.add_gradient(predicted, gradient);
+  EXPECT_EQ(term.value(predicted), 0.0);
+  EXPECT_EQ(gradient.norm(), 0.0);
+}
+
+TEST(EnergyTerms, RayleighDampingGradientIsTheDampingForce) {
+  TermFixture f(MaterialModel::neohookean);
+  const double alpha = 0.7, beta = 0.02, h = 1e-2;
+  RayleighDampingTerm term(*f.embedded, f.mass, alpha, beta);
+  term.set_step(f.state, h);
+  const VectorXd q = f.state + h * f.velocity;
+  expect_derivatives_match(term, f.embedded->stiffness_pattern(), q, false, 1e-6);
+  // ∂E/∂q = (α M + β Kₙ) v with v = (q − qₙ)/h: compare with an independent product.
+  SparseMatrixd K;
+  f.embedded->stiffness(f.state, K, true);
+  const VectorXd expected = alpha * f.mass.cwiseProduct(f.velocity) + beta * (K * f.velocity);
+  VectorXd gradient = VectorXd::Zero(q.size());
+  term.add_gradient(q, gradient);
+  EXPECT_LE((gradient - expected).norm(), 1e-10 * expected.norm());
+}
+
+TEST(EnergyTerms, ExternalWorkIsLinearInTheLoadFactor) {
+  TermFixture f(MaterialModel::stvk);
+  ExternalWorkTerm term(f.forces);
+  term.set_load_factor(0.3);
+  EXPECT_NEAR(term.value(f.state), -0.3 * f.forces.dot(f.state), 1e-14);
+  expect_derivatives_match(term, f.embedded->stiffness_pattern(), f.state, false, 1e-7);
+}
+
+TEST(EnergyTerms, GroundPenaltyDerivativesMatchFiniteDifferences) {
+  TermFixture f(MaterialModel::stvk);
+  GroundPlane ground;
+  ground.point = Vector3d(0, 0, 0.05);  // cuts through the box: half the vertices penetrate
+  ground.normal = Vector3d(0.1, 0.2, 1.0);
+  GroundPenaltyTerm term(ground, 1e4);
+  EXPECT_GT(term.value(f.state), 0.0);
+  expect_derivatives_match(term, f.embedded->stiffness_pattern(), f.state, false, 1e-6);
+}
+
+TEST(EnergyTerms, SumIsTheSumOfItsTerms) {
+  TermFixture f(MaterialModel::corotated);
+  EnergySum sum(f.embedded->stiffness_pattern());
+  const double h = 5e-3;
+  auto& inertia = sum.emplace<InertiaTerm>(f.mass);
+  inertia.set_step(f.model->rest_positions(), h);
+  sum.emplace<ElasticTerm>(*f.embedded);
+  sum.emplace<ExternalWorkTerm>(f.forces);
+  ASSERT_EQ(sum.terms().size(), 3u);
+  double value = 0.0;
+  VectorXd gradient = VectorXd::Zero(f.state.size());
+  SparseMatrixd H = f.embedded->stiffness_pattern();
+  std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
+  for (const auto& term : sum.terms()) {
+    value += term->value(f.state);
+    term->add_gradient(f.state, gradient);
+    term->add_hessian(f.state, H, false);
+  }
+  EXPECT_NEAR(sum.value(f.state), value, 1e-12 * std::abs(value));
+  VectorXd sum_gradient;
+  sum.gradient(f.state, sum_gradient);
+  EXPECT_LE((sum_gradient - gradient).norm(), 1e-12 * gradient.norm());
+  SparseMatrixd sum_hessian;
+  sum.hessian(f.state, sum_hessian, false);
+  EXPECT_LE((sum_hessian - H).norm(), 1e-12 * H.norm());
+}
+
+}  // namespace
+}  // namespace strata
