@@ -54,6 +54,8 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.newton_iterations += b.newton_iterations;
   a.element_evaluations += b.element_evaluations;
   a.factorizations += b.factorizations;
+  a.linear_iterations += b.linear_iterations;
+  a.reused_factor_solves += b.reused_factor_solves;
   a.exact_hessian_iterations += b.exact_hessian_iterations;
   a.projected_hessian_iterations += b.projected_hessian_iterations;
   a.increment_converged_steps += b.increment_converged_steps;

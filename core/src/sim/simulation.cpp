@@ -301,8 +301,14 @@ SimulationCounters Simulation::counters() const {
   SimulationCounters counters = m_newton;
   counters.steps = m_steps - m_first_step;
   counters.element_evaluations = m_model->element_evaluations();
-  if (m_implicit) counters.factorizations = m_implicit->linear_solver().factorizations();
-  if (m_static) counters.factorizations = m_static->linear_solver().factorizations();
+  const SpdSolver* solver = m_implicit ? &m_implicit->linear_solver()
+                            : m_static ? &m_static->linear_solver()
+                                       : nullptr;
+  if (solver != nullptr) {
+    counters.factorizations = solver->factorizations();
+    counters.linear_iterations = solver->cg_iterations();
+    counters.reused_factor_solves = solver->reused_factor_solves();
+  }
   return counters;
 }
 

@@ -144,6 +144,8 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                      {"projected_hessian_iterations", counters.projected_hessian_iterations},
                      {"increment_converged_steps", counters.increment_converged_steps},
                      {"stalled_steps", counters.stalled_steps},
+                     {"linear_iterations", counters.linear_iterations},
+                     {"reused_factor_solves", counters.reused_factor_solves},
                      {"max_residual_ratio", counters.max_residual_ratio}};
   if (counters.stalled_steps > 0)
     stats["newton"]["note"] = std::to_string(counters.stalled_steps) +

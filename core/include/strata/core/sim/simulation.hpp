@@ -72,6 +72,8 @@ struct SimulationCounters {
   long newton_iterations = 0;             ///< over all implicit / static steps
   long long element_evaluations = 0;      ///< from ElasticModel
   long factorizations = 0;                ///< numeric factorisations (or CG setups)
+  long linear_iterations = 0;             ///< CG iterations (incl. those on a previous factor)
+  long reused_factor_solves = 0;          ///< linear solves answered without a new factorisation
   long exact_hessian_iterations = 0;      ///< Newton iterations on the exact Hessian
   long projected_hessian_iterations = 0;  ///< … on the PSD-projected Hessian
   /// Newton solves (time or load steps) that converged on the increment, and that stopped at a
