@@ -7,11 +7,10 @@
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/fem/lumped_mass.hpp"
-#include "strata/core/sim/explicit_integrators.hpp"
-#include "strata/core/sim/implicit_euler.hpp"
+#include "strata/core/sim/newton_solver.hpp"
 #include "strata/core/sim/problem.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
-#include "strata/core/sim/static_solver.hpp"
+#include "strata/core/sim/steppers/time_stepper.hpp"
 
 namespace strata {
 
@@ -21,10 +20,6 @@ std::string format_number(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.3g", value);
   return buffer;
-}
-
-bool is_static(const SolverSettings& settings) {
-  return settings.mode == SimulationMode::static_equilibrium;
 }
 
 }  // namespace
@@ -47,7 +42,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   for (size_t v = 0; v < referenced.size(); ++v)
     if (!referenced[v])
       throw InputError("mesh: vertex " + std::to_string(v) + " belongs to no tet");
-  if (is_static(m_settings) && dirichlet.empty())
+  m_stepper_traits = &find_stepper(m_settings);
+  if (is_static() && dirichlet.empty())
     throw InputError(
         "dirichlet: static mode needs at least one Dirichlet group against rigid motion");
 
@@ -94,7 +90,6 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   m_steps = m_first_step;
   m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
-  m_x_previous = m_x;
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
   m_system.reset(new Problem{.model = *m_embedded,
                              .dof_mass = m_dof_mass,
@@ -107,15 +102,11 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .diagonal = m_diagonal,
                              .ground = m_ground ? &*m_ground : nullptr,
                              .ground_stiffness = m_ground_stiffness});
-  const NewtonControls newton{m_settings.max_newton_iterations, m_settings.newton_tolerance,
-                              m_settings.exact_hessian};
-  if (is_static(m_settings)) {
-    m_static = std::make_unique<StaticSolver>(*m_system, m_settings.linear_solver, newton);
+  m_stepper = m_stepper_traits->make(*m_system, m_settings);
+  if (is_static()) {
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), 0.0, m_x, m_v);
     m_v.setZero();
   } else {
-    if (m_settings.integrator == Integrator::implicit_euler)
-      m_implicit = std::make_unique<ImplicitEuler>(*m_system, m_settings.linear_solver, newton);
     m_system->apply_constraints(time(), m_x, m_v);
   }
   update_mesh_state();
@@ -129,6 +120,10 @@ void Simulation::update_mesh_state() {
 
 Simulation::~Simulation() = default;
 
+bool Simulation::is_static() const {
+  return m_stepper_traits->mode == SimulationMode::static_equilibrium;
+}
+
 void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velocities) {
   if (positions.size() != m_x.size() || velocities.size() != m_v.size())
     throw InputError("initial state: expected " + std::to_string(m_x.size()) +
@@ -136,10 +131,10 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
   if (!positions.allFinite() || !velocities.allFinite())
     throw InputError("initial state: positions and velocities must be finite");
   m_x = positions;
-  m_v = is_static(m_settings) ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
-  if (is_static(m_settings)) {
+  m_v = is_static() ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
+  m_stepper->reset_history();
+  if (is_static()) {
     apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), 0.0, m_x, m_v);
-    m_x_previous = m_x;
   } else {
     m_system->apply_constraints(time(), m_x, m_v);
   }
@@ -147,72 +142,53 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
 }
 
 double Simulation::time() const {
-  if (is_static(m_settings)) return load_factor();
+  if (is_static()) return load_factor();
   return static_cast<double>(m_steps) * m_settings.dt;
 }
 
 double Simulation::load_factor() const {
-  if (is_static(m_settings))
-    return static_cast<double>(m_steps) / static_cast<double>(m_settings.load_steps);
+  if (is_static()) return static_cast<double>(m_steps) / static_cast<double>(m_settings.load_steps);
   return m_system->ramp(time());
 }
 
 bool Simulation::finished() const {
-  if (is_static(m_settings)) return m_steps >= m_settings.load_steps;
+  if (is_static()) return m_steps >= m_settings.load_steps;
   return time() >= m_settings.duration - 1e-9 * m_settings.dt;
 }
 
 void Simulation::advance() {
   STRATA_VERIFY(!finished(), "Simulation::advance called after the run finished");
-  if (is_static(m_settings))
-    advance_static();
-  else
-    advance_dynamic();
+  const double t0 = time();
+  const double t1 = is_static() ? static_cast<double>(m_steps + 1) / m_settings.load_steps
+                                : static_cast<double>(m_steps + 1) * m_settings.dt;
+  const NewtonResult result = m_stepper->step(t0, t1, m_x, m_v);
+  record_newton(result);
+  if (!result.converged)
+    throw_newton_failure(std::string(m_stepper_traits->name), result.iterations, result.residual);
+  if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
+  ++m_steps;
+  update_mesh_state();
+  check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
+                   m_steps, time(), std::string(m_stepper_traits->name));
 }
 
 void Simulation::throw_newton_failure(const std::string& context, int iterations,
                                       double residual) const {
   const long step = m_steps + 1;
-  const double t = is_static(m_settings) ? static_cast<double>(step) / m_settings.load_steps
-                                         : static_cast<double>(step) * m_settings.dt;
+  const double t = is_static() ? static_cast<double>(step) / m_settings.load_steps
+                               : static_cast<double>(step) * m_settings.dt;
   throw DivergenceError(context + ": Newton did not converge at step " + std::to_string(step) +
-                            (is_static(m_settings) ? ", load factor " : ", t = ") +
-                            std::to_string(t) + " after " + std::to_string(iterations) +
-                            " iterations (gradient norm " + format_number(residual) + " N)",
+                            (is_static() ? ", load factor " : ", t = ") + std::to_string(t) +
+                            " after " + std::to_string(iterations) + " iterations (gradient norm " +
+                            format_number(residual) + " N)",
                         step, t);
 }
 
-void Simulation::advance_dynamic() {
-  const double t = time();
-  const double h = m_settings.dt;
-  switch (m_settings.integrator) {
-    case Integrator::symplectic_euler:
-      symplectic_euler_step(*m_system, t, h, m_x, m_v);
-      break;
-    case Integrator::rk4:
-      rk4_step(*m_system, t, h, m_x, m_v);
-      break;
-    case Integrator::implicit_euler: {
-      const NewtonResult result = m_implicit->step(t, h, m_x, m_v);
-      record_newton(result);
-      if (!result.converged)
-        throw_newton_failure("implicit_euler", result.iterations, result.residual);
-      break;
-    }
-  }
-  if (m_ground) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
-  ++m_steps;
-  update_mesh_state();
-  check_divergence(*m_model, positions(), velocities(), m_limits, m_steps, time(),
-                   to_string(m_settings.integrator));
-}
-
 void Simulation::resolve_static() {
-  STRATA_VERIFY(is_static(m_settings) && m_steps > 0,
+  STRATA_VERIFY(is_static() && m_steps > 0,
                 "Simulation::resolve_static needs static mode after a load step");
   const double lambda = load_factor();
-  VectorXd guess = m_x;
-  const NewtonResult result = m_static->solve(lambda, guess);
+  const NewtonResult result = m_stepper->resolve(lambda, m_x, m_v);
   record_newton(result);
   if (!result.converged)
     throw DivergenceError("static: Newton did not converge re-solving load step " +
@@ -221,23 +197,6 @@ void Simulation::resolve_static() {
                               " iterations (gradient norm " + format_number(result.residual) +
                               " N)",
                           m_steps, lambda);
-  m_x = guess;
-  m_x_previous = m_x;  // no extrapolation from a state of another mesh
-  update_mesh_state();
-  check_divergence(*m_model, positions(), VectorXd(), m_limits, m_steps, lambda, "static");
-}
-
-void Simulation::advance_static() {
-  const double lambda = static_cast<double>(m_steps + 1) / m_settings.load_steps;
-  VectorXd guess = m_x;
-  if (m_steps > m_first_step)
-    guess += m_x - m_x_previous;  // linear extrapolation along the load path
-  const NewtonResult result = m_static->solve(lambda, guess);
-  record_newton(result);
-  if (!result.converged) throw_newton_failure("static", result.iterations, result.residual);
-  m_x_previous = m_x;
-  m_x = guess;
-  ++m_steps;
   update_mesh_state();
   check_divergence(*m_model, positions(), VectorXd(), m_limits, m_steps, lambda, "static");
 }
@@ -247,8 +206,13 @@ std::vector<GroupReaction> Simulation::reactions() const {
   m_embedded->forces(m_x, f_int);
   VectorXd f = f_int;
   VectorXd mass_times_acceleration = VectorXd::Zero(m_x.size());
-  if (is_static(m_settings)) {
-    f += load_factor() * m_external + m_static->contact_forces(m_x);
+  if (is_static()) {
+    f += load_factor() * m_external;
+    if (m_ground) {
+      VectorXd penalty_gradient = VectorXd::Zero(m_x.size());
+      add_ground_penalty_gradient(*m_ground, m_ground_stiffness, m_x, penalty_gradient);
+      f -= penalty_gradient;
+    }
   } else {
     f += m_external;
     m_system->add_damping_forces(m_x, m_v, f_int, f);
@@ -281,7 +245,7 @@ double Simulation::elastic_energy() const {
 }
 
 double Simulation::external_potential_energy() const {
-  const double scale = is_static(m_settings) ? load_factor() : 1.0;
+  const double scale = is_static() ? load_factor() : 1.0;
   return -scale * m_external.dot(m_x - m_embedded->rest_positions());
 }
 
@@ -301,9 +265,7 @@ SimulationCounters Simulation::counters() const {
   SimulationCounters counters = m_newton;
   counters.steps = m_steps - m_first_step;
   counters.element_evaluations = m_model->element_evaluations();
-  const SpdSolver* solver = m_implicit ? &m_implicit->linear_solver()
-                            : m_static ? &m_static->linear_solver()
-                                       : nullptr;
+  const SpdSolver* solver = m_stepper->linear_solver();
   if (solver != nullptr) {
     counters.factorizations = solver->factorizations();
     counters.linear_iterations = solver->cg_iterations();

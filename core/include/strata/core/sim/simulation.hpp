@@ -1,8 +1,8 @@
 #pragma once
 /// \file simulation.hpp
-/// The simulation driver: owns the elastic model, constraints, loads, contact and the chosen
-/// integrator or static solver, and advances one time step (dynamic) or one load step (static)
-/// per call. A library class: no I/O.
+/// The simulation driver: owns the elastic model, constraints, loads and contact (bound into a
+/// Problem) and the stepper the settings select (steppers/time_stepper.hpp), and advances one time
+/// step (dynamic) or one load step (static) per call. A library class: no I/O.
 ///
 /// Lifecycle: construct (validates, selects regions, precomputes masses, loads and the stable step
 /// estimate) → set_state (optional initial velocity / shape) → while (!finished()) advance() →
@@ -39,8 +39,8 @@ namespace strata {
 
 struct Problem;
 struct NewtonResult;
-class ImplicitEuler;
-class StaticSolver;
+struct StepperTraits;
+class TimeStepper;
 
 /// Reaction of one Dirichlet group.
 struct GroupReaction {
@@ -159,9 +159,8 @@ class Simulation {
   const DivergenceLimits& divergence_limits() const { return m_limits; }
 
  private:
-  void advance_dynamic();
   void update_mesh_state();
-  void advance_static();
+  bool is_static() const;
   [[noreturn]] void throw_newton_failure(const std::string& context, int iterations,
                                          double residual) const;
 
@@ -183,13 +182,12 @@ class Simulation {
   double m_stable_dt = 0.0;
   DivergenceLimits m_limits;
   std::unique_ptr<Problem> m_system;
-  std::unique_ptr<ImplicitEuler> m_implicit;
-  std::unique_ptr<StaticSolver> m_static;
+  const StepperTraits* m_stepper_traits = nullptr;
+  std::unique_ptr<TimeStepper> m_stepper;
 
   VectorXd m_x;
   VectorXd m_v;
-  VectorXd m_x_previous;  ///< static: equilibrium of the previous load step (extrapolation)
-  VectorXd m_mesh_x;      ///< P q (only with an embedding)
+  VectorXd m_mesh_x;  ///< P q (only with an embedding)
   VectorXd m_mesh_v;
   long m_first_step = 0;
   long m_steps = 0;

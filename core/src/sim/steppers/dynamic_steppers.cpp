@@ -1,0 +1,54 @@
+#include "strata/core/sim/steppers/dynamic_steppers.hpp"
+
+namespace strata {
+
+namespace {
+
+NewtonResult explicit_result() {
+  NewtonResult result;
+  result.converged = true;
+  return result;
+}
+
+}  // namespace
+
+BackwardEulerStepper::BackwardEulerStepper(const Problem& problem, const SolverSettings& settings)
+    : m_integrator(
+          problem, settings.linear_solver,
+          {settings.max_newton_iterations, settings.newton_tolerance, settings.exact_hessian}) {}
+
+NewtonResult BackwardEulerStepper::step(double t0, double t1, VectorXd& q, VectorXd& v) {
+  VectorXd q_step = q, v_step = v;
+  const NewtonResult result = m_integrator.step(t0, t1 - t0, q_step, v_step);
+  if (result.converged) {
+    q.swap(q_step);
+    v.swap(v_step);
+  }
+  return result;
+}
+
+NewtonResult SymplecticEulerStepper::step(double t0, double t1, VectorXd& q, VectorXd& v) {
+  symplectic_euler_step(m_problem, t0, t1 - t0, q, v);
+  return explicit_result();
+}
+
+NewtonResult Rk4Stepper::step(double t0, double t1, VectorXd& q, VectorXd& v) {
+  rk4_step(m_problem, t0, t1 - t0, q, v);
+  return explicit_result();
+}
+
+std::unique_ptr<TimeStepper> make_backward_euler_stepper(const Problem& problem,
+                                                         const SolverSettings& settings) {
+  return std::make_unique<BackwardEulerStepper>(problem, settings);
+}
+
+std::unique_ptr<TimeStepper> make_symplectic_euler_stepper(const Problem& problem,
+                                                           const SolverSettings&) {
+  return std::make_unique<SymplecticEulerStepper>(problem);
+}
+
+std::unique_ptr<TimeStepper> make_rk4_stepper(const Problem& problem, const SolverSettings&) {
+  return std::make_unique<Rk4Stepper>(problem);
+}
+
+}  // namespace strata

@@ -1,0 +1,37 @@
+#include "strata/core/sim/steppers/static_load_stepper.hpp"
+
+namespace strata {
+
+StaticLoadStepper::StaticLoadStepper(const Problem& problem, const SolverSettings& settings)
+    : m_solver(
+          problem, settings.linear_solver,
+          {settings.max_newton_iterations, settings.newton_tolerance, settings.exact_hessian}) {}
+
+NewtonResult StaticLoadStepper::step(double, double t1, VectorXd& q, VectorXd& v) {
+  VectorXd guess = q;
+  if (m_has_previous) guess += q - m_previous;  // linear extrapolation along the load path
+  const NewtonResult result = m_solver.solve(t1, guess);
+  if (!result.converged) return result;
+  m_previous = q;
+  m_has_previous = true;
+  q = guess;
+  v.setZero();
+  return result;
+}
+
+NewtonResult StaticLoadStepper::resolve(double t, VectorXd& q, VectorXd& v) {
+  VectorXd guess = q;
+  const NewtonResult result = m_solver.solve(t, guess);
+  if (!result.converged) return result;
+  q = guess;
+  v.setZero();
+  m_has_previous = false;  // no extrapolation from a state of another mesh
+  return result;
+}
+
+std::unique_ptr<TimeStepper> make_static_load_stepper(const Problem& problem,
+                                                      const SolverSettings& settings) {
+  return std::make_unique<StaticLoadStepper>(problem, settings);
+}
+
+}  // namespace strata
