@@ -14,6 +14,7 @@
 #include "strata/hierarchy/cut_transfer.hpp"
 #include "strata/hierarchy/red_refinement.hpp"
 #include "strata/hierarchy/refinement_force_indicator.hpp"
+#include "strata/hierarchy/refinement_recovery_estimator.hpp"
 #include "strata/hierarchy/refinement_stress_jump_indicator.hpp"
 
 namespace strata {
@@ -34,9 +35,19 @@ bool is_explicit(const SolverSettings& settings) {
 }
 
 std::unique_ptr<RefinementIndicator> make_indicator(const HierarchySettings& settings) {
+  if (settings.indicator == "recovery")
+    return std::make_unique<RecoveryIndicator>(settings.tolerance);
   if (settings.indicator == "stress_jump")
     return std::make_unique<StressJumpIndicator>(settings.criteria.stress_floor);
   return std::make_unique<ForceIndicator>(settings.criteria.stress_floor);
+}
+
+/// Whether every active tet is at `max_level` (nothing left to refine).
+bool all_at_level(const ActiveCut& cut, int max_level) {
+  const std::vector<Index> counts = cut.level_counts();
+  for (int level = 0; level < static_cast<int>(counts.size()) && level < max_level; ++level)
+    if (counts[level] > 0) return false;
+  return true;
 }
 
 /// Σ m_q v_q over the DOF vertices [kg·m/s].
@@ -86,9 +97,13 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
                      " (levels), got " + std::to_string(settings.level));
   if (settings.adapt_every < 1) throw InputError(where + ".adapt_every: must be >= 1");
   if (settings.max_passes < 1) throw InputError(where + ".max_passes: must be >= 1");
-  if (settings.indicator != "force" && settings.indicator != "stress_jump")
-    throw InputError(where + ".indicator: expected \"force\" or \"stress_jump\", got \"" +
+  if (settings.indicator != "recovery" && settings.indicator != "force" &&
+      settings.indicator != "stress_jump")
+    throw InputError(where +
+                     ".indicator: expected \"recovery\", \"force\" or \"stress_jump\", got \"" +
                      settings.indicator + "\"");
+  if (!(settings.tolerance > 0.0 && settings.tolerance < 1.0))
+    throw InputError(where + ".tolerance: must be in (0, 1)");
   validate_refinement_settings(settings.criteria, where);
 }
 
@@ -117,6 +132,9 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
       m_settings.mode == HierarchyMode::full ? m_settings.levels : m_settings.level;
   m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, start_level));
   m_locator = std::make_unique<TreePointLocator>(*m_tree);
+  if (m_settings.indicator == "recovery" && !m_settings.refine_threshold_set)
+    m_settings.criteria.refine_threshold = 1.0;  // a tet's equidistributed share of the tolerance
+  m_report.tolerance = m_settings.tolerance;
   m_controller =
       std::make_unique<RefinementController>(m_settings.criteria, make_indicator(m_settings));
   if (is_explicit(m_solver)) {
@@ -135,7 +153,55 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   make_dirichlet_exact();
   rebuild(0);
   m_bookkeeping_seconds += seconds_since(start);
+  if (m_settings.mode == HierarchyMode::adaptive && !is_static(m_solver) &&
+      m_settings.initial_adaptation && !m_dirichlet.empty())
+    initial_adaptation();
   record_sample();
+}
+
+void AdaptiveSimulation::initial_adaptation() {
+  // Solve–mark–refine on the static response at full load, then start the dynamic run from rest
+  // on the final cut. A static solve that fails (e.g. a load the body cannot carry statically)
+  // ends the adaptation on the cut reached so far.
+  const auto start = Clock::now();
+  SolverSettings statics = m_solver;
+  statics.mode = SimulationMode::static_equilibrium;
+  statics.load_steps = 1;
+  // Only the pattern of the response matters here, not its last digits.
+  statics.newton_tolerance = std::max(statics.newton_tolerance, 1e-6);
+  for (int pass = 0; pass < m_settings.max_passes && !all_at_level(*m_cut, max_refine_level());
+       ++pass) {
+    const FlatTreeMesh& flat = m_constrained->flat;
+    const HangingConstraints& constraints = m_constrained->constraints;
+    SimulationOptions options;
+    options.vertex_embedding = constraints.matrix();
+    options.dof_vertices = constraints.free_vertices();
+    options.extra_mesh_forces =
+        m_mesh_external - gravity_forces(m_simulation->vertex_mass(), m_gravity);
+    std::unique_ptr<Simulation> solve;
+    try {
+      solve = std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet,
+                                           std::vector<RegionLoad>{}, m_ground, m_gravity, statics,
+                                           std::move(options));
+      solve->advance();
+    } catch (const DivergenceError&) {
+      break;
+    }
+    const TetFields fields = solve->model().tet_fields(solve->positions());
+    const CutState state{
+        *m_tree,    flat, solve->positions(), fields, m_mesh_external, solve->vertex_mass(),
+        m_material, 0,    &m_load_traction};
+    if (recovery_error_estimate(state).relative_error <= m_settings.tolerance) break;
+    CutChanges changes = m_controller->decide(state, *m_cut);
+    changes.coarsen.clear();
+    m_report.refused_refinements += changes.refused;
+    if (changes.refine.empty()) break;
+    const CutChangeCounts counts = m_controller->apply(*m_cut, changes, 0);
+    m_report.initial_refinements += static_cast<int>(counts.refined + counts.balance_refined);
+    rebuild(0);
+  }
+  m_report.initial_adaptation_seconds = seconds_since(start);
+  m_bookkeeping_seconds += m_report.initial_adaptation_seconds;
 }
 
 AdaptiveSimulation::~AdaptiveSimulation() = default;
@@ -181,6 +247,7 @@ bool AdaptiveSimulation::children_stable(NodeId n) const {
 }
 
 void AdaptiveSimulation::rebuild(long first_step) {
+  m_estimate_valid = false;
   m_constrained = std::make_unique<ConstrainedCut>(flatten_cut(*m_cut));
   const FlatTreeMesh& flat = m_constrained->flat;
   const HangingConstraints& constraints = m_constrained->constraints;
@@ -198,64 +265,136 @@ void AdaptiveSimulation::rebuild(long first_step) {
 
 void AdaptiveSimulation::advance() {
   if (m_failed) throw std::logic_error("AdaptiveSimulation::advance: a previous cut change failed");
+  if (m_settings.mode == HierarchyMode::adaptive && !is_static(m_solver) &&
+      m_settings.in_step_refinement) {
+    advance_with_redo();
+    record_sample();
+    return;
+  }
   const auto start = Clock::now();
+  m_estimate_valid = false;
   m_simulation->advance();
   m_stepping_seconds += seconds_since(start);
   if (m_settings.mode == HierarchyMode::adaptive) {
     if (is_static(m_solver)) {
       // Solve–mark–refine: re-solve the same load factor on each new cut.
-      for (int pass = 0; pass < m_settings.max_passes && adapt(pass); ++pass) {
+      for (int pass = 0; pass < m_settings.max_passes && adapt(pass, true, true); ++pass) {
         const auto solve_start = Clock::now();
         m_simulation->resolve_static();
         m_stepping_seconds += seconds_since(solve_start);
       }
     } else if (step_count() % m_settings.adapt_every == 0 && !finished()) {
-      adapt(0);
+      adapt(0, true, true);
     }
   }
   record_sample();
 }
 
-bool AdaptiveSimulation::adapt(int pass) {
-  const auto start = Clock::now();
+void AdaptiveSimulation::advance_with_redo() {
+  // The start-of-step state on the current cut, to redo the step from on a refined cut.
+  VectorXd x0 = m_simulation->positions();
+  VectorXd v0 = m_simulation->velocities();
+  double kinetic0 = m_simulation->kinetic_energy();
+  Vector3d momentum0 = momentum(*m_simulation);
+  auto step_start = Clock::now();
+  m_estimate_valid = false;
+  m_simulation->advance();
+  double attempt = seconds_since(step_start);
+  m_stepping_seconds += attempt;
+  for (int pass = 0; pass < m_settings.max_passes; ++pass) {
+    const CutChanges changes = decide(true, false);
+    if (changes.refine.empty()) break;
+    ++m_report.redone_steps;
+    m_report.redo_seconds += attempt;
+    // The Simulation is one step ahead: carry the start-of-step state to the new cut and redo
+    // the step there (the new cut's start state is the one a further pass starts from).
+    change_cut(changes, pass, step_count() - 1, x0, v0, kinetic0, momentum0);
+    x0 = m_simulation->positions();
+    v0 = m_simulation->velocities();
+    kinetic0 = m_simulation->kinetic_energy();
+    momentum0 = momentum(*m_simulation);
+    step_start = Clock::now();
+    m_estimate_valid = false;
+    m_simulation->advance();
+    attempt = seconds_since(step_start);
+    m_stepping_seconds += attempt;
+  }
+  if (step_count() % m_settings.adapt_every == 0 && !finished()) adapt(0, false, true);
+}
+
+CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
   const TetFields fields = sim.model().tet_fields(sim.positions());
-  const CutState state{
-      *m_tree,           flat,       sim.positions(),  fields,          m_mesh_external,
-      sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
-  const CutChanges changes = m_controller->decide(state, *m_cut);
+  CutState state{*m_tree,           flat,       sim.positions(),  fields,          m_mesh_external,
+                 sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
+  state.solution_energy_scale = m_energy_scale;
+  m_estimate = recovery_error_estimate(state);
+  m_estimate_valid = true;
+  // The recovery criterion refines only while the run's estimate exceeds the tolerance.
+  const bool within_tolerance =
+      m_settings.indicator == "recovery" && m_estimate.relative_error <= m_settings.tolerance;
+  if (!coarsen && (!refine || within_tolerance)) return {};
+  CutChanges changes = m_controller->decide(state, *m_cut);
+  if (!refine || within_tolerance) {
+    changes.refine.clear();
+  } else {
+    m_report.refused_refinements += changes.refused;
+  }
+  if (!coarsen) changes.coarsen.clear();
+  return changes;
+}
+
+bool AdaptiveSimulation::adapt(int pass, bool refine, bool coarsen) {
+  const auto start = Clock::now();
+  const CutChanges changes = decide(refine, coarsen);
   if (changes.refine.empty() && changes.coarsen.empty()) {
     m_bookkeeping_seconds += seconds_since(start);
     return false;
   }
+  m_bookkeeping_seconds += seconds_since(start);
+  const VectorXd x = m_simulation->positions();
+  const VectorXd v = m_simulation->velocities();
+  change_cut(changes, pass, step_count(), x, v, m_simulation->kinetic_energy(),
+             momentum(*m_simulation));
+  return true;
+}
 
+void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long first_step,
+                                    const VectorXd& x_mesh, const VectorXd& v_mesh,
+                                    double old_kinetic_energy, const Vector3d& old_momentum) {
+  const auto start = Clock::now();
+  const Simulation& sim = *m_simulation;
   CutChangeRecord record;
   record.step = sim.step_count();
   record.pass = pass;
   record.time = sim.time();
   record.tets_before = m_cut->size();
-  record.energy_before = sim.kinetic_energy() + sim.elastic_energy();
-  record.momentum_before = momentum(sim);
-  const VectorXd old_positions = sim.positions();
-  const VectorXd old_velocities = sim.velocities();
+  {
+    // Energy of the state being moved (the start-of-step state for a redo).
+    const VectorXd x_q = m_constrained->constraints.restrict_to_free(x_mesh);
+    record.energy_before = old_kinetic_energy + sim.embedded_model().energy(x_q);
+  }
+  record.momentum_before = old_momentum;
+  const VectorXd old_positions = x_mesh;
+  const VectorXd old_velocities = v_mesh;
   const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
   record.refined = counts.refined + counts.balance_refined;
   record.coarsened = counts.coarsened;
 
-  // Restart on the new cut at the same step (static runs then re-solve that load step). The new
-  // objects are built aside and swapped in only when complete: an exception leaves the previous
-  // Simulation in place and marks the driver failed.
+  // The new objects are built aside and swapped in only when complete: an exception leaves the
+  // previous Simulation in place and marks the driver failed.
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
   std::unique_ptr<Simulation> old_simulation = std::move(m_simulation);
   try {
-    rebuild(old_simulation->step_count());
+    rebuild(first_step);
     const FlatTreeMesh& new_flat = m_constrained->flat;
     const HangingConstraints& constraints = m_constrained->constraints;
     const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
     const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
     m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
-    keep_kinetic_energy(old_cut->flat, old_cut->constraints, *old_simulation);
+    keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_simulation->dof_vertex_mass(),
+                        old_kinetic_energy, old_momentum);
   } catch (...) {
     m_constrained = std::move(old_cut);
     m_simulation = std::move(old_simulation);
@@ -275,12 +414,33 @@ bool AdaptiveSimulation::adapt(int pass) {
   record.seconds = seconds_since(start);
   m_bookkeeping_seconds += record.seconds;
   m_changes.push_back(record);
-  return true;
+}
+
+int AdaptiveSimulation::max_refine_level() const {
+  const int max_level = m_settings.criteria.max_level;
+  return max_level < 0 ? m_tree->max_level() : std::min(max_level, m_tree->max_level());
+}
+
+RecoveryEstimate AdaptiveSimulation::estimate_error() {
+  if (!m_estimate_valid) {
+    const Simulation& sim = *m_simulation;
+    const TetFields fields = sim.model().tet_fields(sim.positions());
+    CutState state{*m_tree,    m_constrained->flat, sim.positions(),
+                   fields,     m_mesh_external,     sim.vertex_mass(),
+                   m_material, sim.step_count(),    &m_load_traction};
+    state.solution_energy_scale = m_energy_scale;
+    m_estimate = recovery_error_estimate(state);
+    m_estimate_valid = true;
+  }
+  m_energy_scale = m_estimate.reference_energy_sq;
+  return m_estimate;
 }
 
 void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
                                              const HangingConstraints& old_constraints,
-                                             const Simulation& old_simulation) {
+                                             const VectorXd& old_dof_mass,
+                                             double old_kinetic_energy,
+                                             const Vector3d& old_momentum) {
   // The transferred velocities do not carry the old kinetic energy and momentum: lumped masses of
   // one linear field differ between cuts, and merging drops the children's detail. Within the
   // changed region S (free DOF vertices that are new or whose mass changed) the velocities are
@@ -293,7 +453,6 @@ void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
   const FlatTreeMesh& flat = m_constrained->flat;
   const HangingConstraints& constraints = m_constrained->constraints;
   std::vector<double> old_mass(m_tree->vertex_capacity(), -1.0);
-  const VectorXd& old_dof_mass = old_simulation.dof_vertex_mass();
   for (size_t q = 0; q < old_constraints.free_vertices().size(); ++q)
     old_mass[old_flat.tree_vertices[old_constraints.free_vertices()[q]]] = old_dof_mass[q];
   const VectorXd& mass = m_simulation->dof_vertex_mass();
@@ -317,20 +476,18 @@ void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
   }
   const Vector3d region_mean = region_momentum / region_mass;
   const Vector3d outside_momentum = momentum(*m_simulation) - region_momentum;
-  const Vector3d mean = (momentum(old_simulation) - outside_momentum) / region_mass;
+  const Vector3d mean = (old_momentum - outside_momentum) / region_mass;
   double deviation = 0.0;
   for (Index q : changed)
     deviation += mass[q] * (v.segment<3>(3 * q) - region_mean).squaredNorm();
-  const double target = old_simulation.kinetic_energy() -
-                        (m_simulation->kinetic_energy() - region_energy) -
+  const double target = old_kinetic_energy - (m_simulation->kinetic_energy() - region_energy) -
                         0.5 * region_mass * mean.squaredNorm();
   double scale = 0.0;
   Vector3d shifted_mean = mean;
   if (target >= 0.0) {
     scale = deviation > 0.0 ? std::sqrt(2.0 * target / deviation) : 0.0;
   } else {
-    const double available =
-        old_simulation.kinetic_energy() - (m_simulation->kinetic_energy() - region_energy);
+    const double available = old_kinetic_energy - (m_simulation->kinetic_energy() - region_energy);
     const double mean_energy = 0.5 * region_mass * mean.squaredNorm();
     shifted_mean =
         available > 0.0 ? Vector3d(mean * std::sqrt(available / mean_energy)) : Vector3d::Zero();
@@ -348,6 +505,13 @@ void AdaptiveSimulation::record_sample() {
   sample.tets = m_cut->size();
   sample.dofs = m_simulation->embedded_model().num_dofs();
   sample.hanging = m_constrained->constraints.num_hanging();
+  const RecoveryEstimate estimate = estimate_error();
+  sample.estimated_error = estimate.relative_error;
+  sample.estimated_energy_error = estimate.relative_energy_error;
+  if (!m_history.empty()) {  // accepted steps (the initial sample is the cut before any step)
+    m_report.max_estimated_error = std::max(m_report.max_estimated_error, sample.estimated_error);
+    if (sample.estimated_error > m_settings.tolerance) ++m_report.steps_over_tolerance;
+  }
   m_history.push_back(sample);
 }
 

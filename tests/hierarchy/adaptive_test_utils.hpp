@@ -38,11 +38,17 @@ inline RegionLoad box_load(const Vector3d& lo, const Vector3d& hi, const Vector3
   return load;
 }
 
+/// The driver with periodic adaptation (every `adapt_every` steps, no redo, no initial
+/// adaptation) and the force indicator: the mechanics these tests check. The error-controlled
+/// defaults (recovery indicator, tolerance, in-step refinement) are tested on their own.
 inline HierarchySettings hierarchy(int levels, HierarchyMode mode, int level = 0) {
   HierarchySettings settings;
   settings.levels = levels;
   settings.mode = mode;
   settings.level = level;
+  settings.indicator = "force";
+  settings.in_step_refinement = false;
+  settings.initial_adaptation = false;
   return settings;
 }
 

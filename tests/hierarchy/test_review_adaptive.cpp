@@ -18,6 +18,9 @@ HierarchySettings adaptive_from_coarse(int levels) {
   settings.levels = levels;
   settings.mode = HierarchyMode::adaptive;
   settings.level = 0;
+  settings.indicator = "force";  // the periodic driver's mechanics (see adaptive_test_utils.hpp)
+  settings.in_step_refinement = false;
+  settings.initial_adaptation = false;
   return settings;
 }
 

@@ -8,7 +8,8 @@ HierarchySettings parse_hierarchy(const SceneValue& value) {
   value.expect_object({"levels", "mode", "level", "adapt_every", "max_passes", "indicator",
                        "refine_threshold", "coarsen_tolerance", "coarsen_indicator_fraction",
                        "stress_floor", "min_steps_between_changes", "max_active_elements",
-                       "max_level", "balance"});
+                       "max_level", "balance", "tolerance", "initial_adaptation",
+                       "in_step_refinement"});
   HierarchySettings settings;
   settings.levels = value.at("levels").integer(0);
   if (settings.levels > 8) value.at("levels").fail("must be at most 8");
@@ -25,12 +26,23 @@ HierarchySettings parse_hierarchy(const SceneValue& value) {
   if (value.has("adapt_every")) settings.adapt_every = value.at("adapt_every").integer(1);
   if (value.has("max_passes")) settings.max_passes = value.at("max_passes").integer(1);
   if (value.has("indicator")) {
+    static const char* const kIndicators[] = {"recovery", "force", "stress_jump"};
     settings.indicator =
-        value.at("indicator").choice({"force", "stress_jump"}) == 0 ? "force" : "stress_jump";
+        kIndicators[value.at("indicator").choice({"recovery", "force", "stress_jump"})];
   }
+  if (value.has("tolerance")) {
+    settings.tolerance = value.at("tolerance").positive();
+    if (settings.tolerance >= 1.0) value.at("tolerance").fail("must be in (0, 1)");
+  }
+  if (value.has("initial_adaptation"))
+    settings.initial_adaptation = value.at("initial_adaptation").boolean();
+  if (value.has("in_step_refinement"))
+    settings.in_step_refinement = value.at("in_step_refinement").boolean();
   RefinementSettings& criteria = settings.criteria;
-  if (value.has("refine_threshold"))
+  if (value.has("refine_threshold")) {
     criteria.refine_threshold = value.at("refine_threshold").positive();
+    settings.refine_threshold_set = true;
+  }
   if (value.has("coarsen_tolerance"))
     criteria.coarsen_tolerance = value.at("coarsen_tolerance").positive();
   if (value.has("coarsen_indicator_fraction")) {

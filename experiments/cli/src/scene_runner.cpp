@@ -95,13 +95,17 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
                             {"time", nlohmann::json::array()},
                             {"tets", nlohmann::json::array()},
                             {"dofs", nlohmann::json::array()},
-                            {"hanging_vertices", nlohmann::json::array()}};
+                            {"hanging_vertices", nlohmann::json::array()},
+                            {"estimated_error", nlohmann::json::array()},
+                            {"estimated_energy_error", nlohmann::json::array()}};
   for (const CutSample& sample : adaptive.history()) {
     history["step"].push_back(sample.step);
     history["time"].push_back(sample.time);
     history["tets"].push_back(sample.tets);
     history["dofs"].push_back(sample.dofs);
     history["hanging_vertices"].push_back(sample.hanging);
+    history["estimated_error"].push_back(sample.estimated_error);
+    history["estimated_energy_error"].push_back(sample.estimated_energy_error);
   }
   block["history"] = history;
   Index refinements = 0, coarsenings = 0;
@@ -124,6 +128,16 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
   block["refinements"] = refinements;
   block["coarsenings"] = coarsenings;
   block["changes"] = changes;
+  const ToleranceReport& report = adaptive.tolerance_report();
+  block["tolerance"] = report.tolerance;
+  block["estimated_error"] = report.max_estimated_error;
+  block["tolerance_met"] = report.steps_over_tolerance == 0;
+  block["steps_over_tolerance"] = report.steps_over_tolerance;
+  block["refused_refinements"] = report.refused_refinements;
+  block["redone_steps"] = report.redone_steps;
+  block["redo_seconds"] = report.redo_seconds;
+  block["initial_refinements"] = report.initial_refinements;
+  block["initial_adaptation_seconds"] = report.initial_adaptation_seconds;
   return block;
 }
 
@@ -369,6 +383,19 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   progress.clear();
   save_tables();
   finish();
+  if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
+      adaptive && adaptive->settings().mode == HierarchyMode::adaptive) {
+    const ToleranceReport& report = adaptive->tolerance_report();
+    if (report.steps_over_tolerance > 0) {
+      log.flush();
+      std::cerr << "strata: warning: " << scene.file.string() << ": the estimated error exceeded "
+                << "hierarchy.tolerance " << report.tolerance << " at "
+                << report.steps_over_tolerance << " of " << summary.steps << " steps (largest "
+                << report.max_estimated_error << "; " << report.refused_refinements
+                << " refinements refused by max_level, max_active_elements, the explicit step "
+                   "limit or hysteresis)\n";
+    }
+  }
   if (!options.quiet) {
     log << "strata: done: " << summary.steps << " steps, " << summary.frames << " frames in "
         << format_duration(summary.wall_seconds) << "; output in " << summary.output_dir.string()

@@ -49,6 +49,7 @@
 #include "strata/hierarchy/finest_level.hpp"
 #include "strata/hierarchy/hanging_constraints.hpp"
 #include "strata/hierarchy/refinement_controller.hpp"
+#include "strata/hierarchy/refinement_recovery_estimator.hpp"
 #include "strata/hierarchy/tree_point_location.hpp"
 
 namespace strata {
@@ -62,15 +63,32 @@ std::string to_string(HierarchyMode mode);
 struct HierarchySettings {
   int levels = 1;                                ///< L: red-refinement levels below the coarse mesh
   HierarchyMode mode = HierarchyMode::adaptive;  ///<
-  int level = 0;                    ///< uniform: the level k; adaptive: the starting level
-  int adapt_every = 10;             ///< dynamic: steps between two evaluations of the criteria
-  int max_passes = 4;               ///< static: solve–mark–refine passes per load step (≥ 1)
-  std::string indicator = "force";  ///< "force" or "stress_jump"
-  RefinementSettings criteria;      ///< thresholds and hysteresis
+  int level = 0;         ///< uniform: the level k; adaptive: the starting level
+  int adapt_every = 10;  ///< dynamic: steps between two coarsening evaluations
+  /// Refinement passes per step (≥ 1): static, solve–mark–refine per load step; dynamic, redos of
+  /// a step on a refined cut; and the passes of the initial adaptation.
+  int max_passes = 4;
+  /// Refinement criterion: "recovery" (the error estimate, refinement_recovery_estimator.hpp),
+  /// "force" or "stress_jump".
+  std::string indicator = "recovery";
+  /// τ ∈ (0, 1): the relative displacement error against full resolution the run may have; the
+  /// recovery indicator's threshold follows from it (refine where a tet's estimated error exceeds
+  /// its equidistributed share of τ), and no refinement happens while the estimate is below τ.
+  double tolerance = 0.01;
+  /// Dynamic runs: before the first step, adapt the cut to the static response to the loads and
+  /// prescribed motions at full load (solve–mark–refine, `max_passes`), then start from rest.
+  bool initial_adaptation = true;
+  /// Dynamic runs: test each step's result and redo the step on the refined cut (from the
+  /// start-of-step state) where the criteria fail; false: refine every `adapt_every` steps.
+  bool in_step_refinement = true;
+  /// `criteria.refine_threshold` was given explicitly (an expert override of the tolerance rule).
+  bool refine_threshold_set = false;
+  RefinementSettings criteria;  ///< thresholds and hysteresis
 };
 
 /// Throws InputError naming `where` ("hierarchy") and the key for invalid settings: levels ∉ 0..8,
-/// level ∉ 0..levels, adapt_every < 1, max_passes < 1, an unknown indicator, invalid criteria.
+/// level ∉ 0..levels, adapt_every < 1, max_passes < 1, an unknown indicator, tolerance ∉ (0, 1),
+/// invalid criteria.
 void validate_hierarchy_settings(const HierarchySettings& settings, const std::string& where);
 
 /// One change of the active cut.
@@ -96,6 +114,25 @@ struct CutSample {
   Index tets = 0;     ///< active tets
   Index dofs = 0;     ///< 3·#free vertices
   Index hanging = 0;  ///< hanging vertices
+  /// Estimated relative displacement error against full resolution after the step
+  /// (refinement_recovery_estimator.hpp).
+  double estimated_error = 0.0;
+  /// Relative energy-norm error against the exact solution (the estimate's raw form).
+  double estimated_energy_error = 0.0;
+};
+
+/// How the run kept its tolerance.
+struct ToleranceReport {
+  double tolerance = 0.0;
+  double max_estimated_error = 0.0;  ///< largest estimate over the accepted steps
+  long steps_over_tolerance = 0;     ///< accepted steps whose estimate exceeded the tolerance
+  /// Refinements the criteria asked for but could not make (max_level, element budget, explicit
+  /// step veto, hysteresis) over the run.
+  long refused_refinements = 0;
+  long redone_steps = 0;        ///< dynamic steps redone on a refined cut
+  double redo_seconds = 0.0;    ///< wall time of the discarded attempts [s]
+  int initial_refinements = 0;  ///< nodes refined by the initial adaptation
+  double initial_adaptation_seconds = 0.0;
 };
 
 class AdaptiveSimulation {
@@ -146,16 +183,29 @@ class AdaptiveSimulation {
   /// Wall time spent in cut changes (bookkeeping) and in Simulation::advance [s].
   double bookkeeping_seconds() const { return m_bookkeeping_seconds; }
   double stepping_seconds() const { return m_stepping_seconds; }
+  /// The tolerance, the estimates and the redo counts of the run.
+  const ToleranceReport& tolerance_report() const { return m_report; }
 
  private:
   void make_dirichlet_exact();
   void rebuild(long first_step);
-  bool adapt(int pass);
+  bool adapt(int pass, bool refine, bool coarsen);
+  /// Changes the cut by `changes` and moves the mesh-level state (x, v) of the current cut, with
+  /// its kinetic energy and momentum, onto it; the new Simulation starts at `first_step`.
+  void change_cut(const CutChanges& changes, int pass, long first_step, const VectorXd& x,
+                  const VectorXd& v, double old_kinetic_energy, const Vector3d& old_momentum);
+  CutChanges decide(bool refine, bool coarsen);
+  void advance_with_redo();
+  void initial_adaptation();
+  /// The estimate of the current state; raises the run's energy scale to its energy norm.
+  RecoveryEstimate estimate_error();
+  int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
   bool m_failed = false;  ///< a cut change threw: the cut no longer matches the Simulation
   void record_sample();
   void keep_kinetic_energy(const FlatTreeMesh& old_flat, const HangingConstraints& old_constraints,
-                           const Simulation& old_simulation);
+                           const VectorXd& old_dof_mass, double old_kinetic_energy,
+                           const Vector3d& old_momentum);
 
   HierarchySettings m_settings;
   Material m_material;
@@ -180,6 +230,10 @@ class AdaptiveSimulation {
   SimulationCounters m_finished_counters;  ///< of the Simulations already replaced
   double m_bookkeeping_seconds = 0.0;
   double m_stepping_seconds = 0.0;
+  ToleranceReport m_report;
+  double m_energy_scale = 0.0;  ///< largest ‖u‖_E² of the accepted steps so far [J]
+  RecoveryEstimate m_estimate;  ///< of the current state while m_estimate_valid
+  bool m_estimate_valid = false;
 };
 
 }  // namespace strata

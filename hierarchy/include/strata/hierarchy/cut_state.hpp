@@ -41,6 +41,10 @@ struct CutState {
   /// load is at the finest level, which the flat vertices' forces smear over coarse tets. Null:
   /// only `external_forces` are used.
   const VectorXd* finest_load_traction = nullptr;
+  /// Optional: the squared energy norm ‖u‖_E² [J] the error estimate is relative to — the largest
+  /// over the run so far, so that the first small-strain steps of a run are not judged relative
+  /// to their own tiny deformation. 0: the state's own.
+  double solution_energy_scale = 0.0;
 };
 
 }  // namespace strata

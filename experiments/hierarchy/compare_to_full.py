@@ -1,0 +1,109 @@
+#!/usr/bin/python3
+"""Error of hierarchy runs against full resolution, over the whole run.
+
+Runs a scene (which has a "hierarchy" key) once with hierarchy.mode=full — the reference, reused
+when its outputs are present — and once per configuration given with --run NAME:key=value,... The
+error of a run is the largest probe-displacement difference to the full run over every frame and
+probe, relative to the largest full-resolution probe displacement (the measure hierarchy.tolerance
+bounds). Prints one line per run and writes <out>/compare.json:
+
+  compare_to_full.py SCENE.json [--out DIR] [--strata PATH]
+                     [--run adaptive:] [--run tight:tolerance=0.005] [--set key=value ...]
+
+`--set` applies to every run (full included), e.g. --set solver.duration=0.1.
+"""
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def read_probes(folder):
+    frames = {}
+    with open(os.path.join(folder, "probes.csv")) as f:
+        for row in csv.DictReader(f):
+            key = (round(float(row["time"]), 12), int(row["probe"]))
+            frames[key] = (float(row["ux"]), float(row["uy"]), float(row["uz"]))
+    return frames
+
+
+def run(args, name, settings):
+    folder = os.path.join(args.out, name)
+    stats_path = os.path.join(folder, "stats.json")
+    command = [args.strata, "run", args.scene, "--out", folder, "--quiet",
+               "--set", "output.vtk=false"]
+    for item in args.set:
+        command += ["--set", item]
+    for key, value in settings.items():
+        command += ["--set", f"hierarchy.{key}={value}"]
+    if name == "full" and os.path.exists(stats_path) and not args.rerun_full:
+        return json.load(open(stats_path)), folder
+    start = time.monotonic()
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        sys.exit(f"compare_to_full: {name} failed ({result.returncode}): {result.stderr.strip()}")
+    stats = json.load(open(stats_path))
+    stats["measured_seconds"] = time.monotonic() - start
+    return stats, folder
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("scene")
+    parser.add_argument("--out", default=os.path.join(REPO, "out", "compare"))
+    parser.add_argument("--strata", default=os.path.join(REPO, "build", "experiments", "cli",
+                                                         "strata"))
+    parser.add_argument("--run", action="append", default=[])
+    parser.add_argument("--set", action="append", default=[])
+    parser.add_argument("--rerun-full", action="store_true")
+    args = parser.parse_args()
+    runs = args.run or ["adaptive:"]
+    full_stats, full_folder = run(args, "full", {"mode": "full"})
+    reference = read_probes(full_folder)
+    scale = max(sum(c * c for c in u) ** 0.5 for u in reference.values())
+    report = {"scene": args.scene, "full": {"wall_seconds": full_stats["wall_seconds"],
+                                            "tets": full_stats["tets"]}, "runs": []}
+    print(f"full: {full_stats['tets']} tets, {full_stats['wall_seconds']:.2f} s, "
+          f"largest probe displacement {scale:.4g} m")
+    for spec in runs:
+        name, _, text = spec.partition(":")
+        settings = dict(item.split("=", 1) for item in text.split(",") if item)
+        stats, folder = run(args, name, settings)
+        probes = read_probes(folder)
+        worst, worst_key = 0.0, None
+        for key, u in reference.items():
+            if key not in probes:
+                sys.exit(f"compare_to_full: {name} lacks frame/probe {key}")
+            d = sum((a - b) ** 2 for a, b in zip(probes[key], u)) ** 0.5
+            if d > worst:
+                worst, worst_key = d, key
+        last_time = max(k[0] for k in reference)
+        last = max(sum((a - b) ** 2 for a, b in zip(probes[k], reference[k])) ** 0.5
+                   for k in reference if k[0] == last_time)
+        h = stats.get("hierarchy", {})
+        history = h.get("history", {}).get("tets", [])
+        entry = {"name": name, "settings": settings, "error": worst / scale,
+                 "error_last_frame": last / scale, "worst_frame_probe": worst_key,
+                 "wall_seconds": stats["wall_seconds"],
+                 "speedup": full_stats["wall_seconds"] / stats["wall_seconds"],
+                 "final_tets": stats["tets"], "max_tets": max(history) if history else None,
+                 "estimated_error": h.get("estimated_error"),
+                 "redone_steps": h.get("redone_steps")}
+        report["runs"].append(entry)
+        print(f"{name}: error {100 * entry['error']:.2f} % (last frame "
+              f"{100 * entry['error_last_frame']:.2f} %), {entry['wall_seconds']:.2f} s "
+              f"({entry['speedup']:.2f}x faster than full), tets final {entry['final_tets']} "
+              f"max {entry['max_tets']}, estimated {entry['estimated_error']}, "
+              f"redone steps {entry['redone_steps']}")
+    os.makedirs(args.out, exist_ok=True)
+    with open(os.path.join(args.out, "compare.json"), "w") as f:
+        json.dump(report, f, indent=2)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,85 @@
+#include "strata/hierarchy/refinement_recovery_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+namespace {
+
+/// 2ψ(e) = 2μ e:e + λ tr(e)² for a symmetric tensor in Voigt form [xx yy zz xy yz xz].
+double twice_energy_density(const Vector6d& e, const LameParameters& lame) {
+  const double trace = e[0] + e[1] + e[2];
+  const double contraction = e.head<3>().squaredNorm() + 2.0 * e.tail<3>().squaredNorm();
+  return 2.0 * lame.mu * contraction + lame.lambda * trace * trace;
+}
+
+}  // namespace
+
+RecoveryEstimate recovery_error_estimate(const CutState& state) {
+  const TetMesh& mesh = state.flat.mesh;
+  const Index num_tets = mesh.tets.rows();
+  const Index num_vertices = mesh.vertices.rows();
+  const LameParameters lame = state.material.lame();
+  const VectorXd volume = tet_rest_volumes(mesh);
+  const auto& strain = state.fields.green_strain;
+
+  Eigen::Matrix<double, Eigen::Dynamic, 6> recovered =
+      Eigen::Matrix<double, Eigen::Dynamic, 6>::Zero(num_vertices, 6);
+  VectorXd weight = VectorXd::Zero(num_vertices);
+  for (Index t = 0; t < num_tets; ++t)
+    for (int k = 0; k < 4; ++k) {
+      recovered.row(mesh.tets(t, k)) += volume[t] * strain.row(t);
+      weight[mesh.tets(t, k)] += volume[t];
+    }
+  for (Index v = 0; v < num_vertices; ++v)
+    if (weight[v] > 0.0) recovered.row(v) /= weight[v];
+
+  RecoveryEstimate estimate;
+  estimate.element_error_sq.resize(num_tets);
+  const int depth = state.tree.max_level();
+  double total = 0.0, raw_total = 0.0;
+  for (Index t = 0; t < num_tets; ++t) {
+    const Vector6d own = strain.row(t).transpose();
+    Vector6d sum = Vector6d::Zero();
+    double vertex_terms = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const Vector6d d = recovered.row(mesh.tets(t, k)).transpose() - own;
+      vertex_terms += twice_energy_density(d, lame);
+      sum += d;
+    }
+    const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
+    const int level = state.tree.level(state.flat.tet_nodes[t]);
+    const double removed = 1.0 - std::pow(2.0, -(depth - level));
+    estimate.element_error_sq[t] = error_sq * removed * removed;
+    raw_total += error_sq;
+    total += estimate.element_error_sq[t];
+    estimate.solution_energy_sq += volume[t] * twice_energy_density(own, lame);
+  }
+  estimate.reference_energy_sq = std::max(estimate.solution_energy_sq, state.solution_energy_scale);
+  if (estimate.reference_energy_sq > 0.0) {
+    estimate.relative_error =
+        kDisplacementPerEnergyError * std::sqrt(total / estimate.reference_energy_sq);
+    estimate.relative_energy_error = std::sqrt(raw_total / estimate.reference_energy_sq);
+  }
+  return estimate;
+}
+
+RecoveryIndicator::RecoveryIndicator(double tolerance) : m_tolerance(tolerance) {
+  if (!(tolerance > 0.0 && tolerance < 1.0))
+    throw InputError("hierarchy.tolerance: must be in (0, 1)");
+}
+
+void RecoveryIndicator::evaluate(const CutState& state, VectorXd& eta) const {
+  const RecoveryEstimate estimate = recovery_error_estimate(state);
+  const Index n = estimate.element_error_sq.size();
+  eta.setZero(n);
+  if (estimate.reference_energy_sq <= 0.0 || n == 0) return;
+  const double energy_tolerance = m_tolerance / kDisplacementPerEnergyError;
+  const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
+  eta = (estimate.element_error_sq / share).cwiseSqrt();
+}
+
+}  // namespace strata

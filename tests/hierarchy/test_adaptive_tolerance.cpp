@@ -1,0 +1,149 @@
+// The error-controlled defaults of the adaptive driver: the recovery estimate against
+// hierarchy.tolerance, the initial adaptation before the first step, in-step refinement with
+// redone steps, and the report of a tolerance the run could not meet. Errors are measured against
+// a full-resolution run of the same scene, over every step and probe.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "adaptive_test_utils.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/hierarchy/adaptive_simulation.hpp"
+
+namespace strata {
+namespace {
+
+using testing::box_load;
+using testing::fixed_plane;
+using testing::rubber;
+
+/// A plate clamped on two opposite sides and poked off-centre by a small loaded patch, backward
+/// Euler with light damping: bending plus a local load, 96 roots, two levels (6,144 finest tets).
+struct PokedPlate {
+  TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 0.5, 0.1), {4, 4, 1});
+  std::vector<DirichletSpec> fixed = {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX()),
+                                      fixed_plane("fixed.1", Vector3d(1, 0, 0), Vector3d::UnitX())};
+  std::vector<RegionLoad> loads = {
+      box_load(Vector3d(0.3, 0.2, 0.1), Vector3d(0.4, 0.3, 0.1), Vector3d(0, 0, -30.0))};
+  MatrixX3d probes =
+      (MatrixX3d(3, 3) << 0.35, 0.25, 0.1, 0.5, 0.25, 0.05, 0.75, 0.25, 0.1).finished();
+
+  SolverSettings solver() const {
+    SolverSettings settings;
+    settings.integrator = Integrator::implicit_euler;
+    settings.dt = 2e-3;
+    settings.duration = 0.04;
+    return settings;
+  }
+  Material material() const {
+    Material m = rubber();
+    m.mass_damping = 2.0;
+    return m;
+  }
+
+  /// Probe displacements (#probes × 3) after every step.
+  std::vector<MatrixX3d> run(AdaptiveSimulation& sim) const {
+    const std::vector<RootPoint> points = sim.locate(probes, "probes", 1e-9);
+    std::vector<MatrixX3d> frames;
+    while (!sim.finished()) {
+      sim.advance();
+      frames.push_back(sim.displacements(points));
+    }
+    return frames;
+  }
+  std::vector<MatrixX3d> run(const HierarchySettings& h, ToleranceReport* report = nullptr,
+                             Index* initial_tets = nullptr) const {
+    AdaptiveSimulation sim(coarse, h, material(), fixed, loads, std::nullopt, Vector3d::Zero(),
+                           solver());
+    if (initial_tets) *initial_tets = sim.cut().size();
+    std::vector<MatrixX3d> frames = run(sim);
+    if (report) *report = sim.tolerance_report();
+    return frames;
+  }
+};
+
+HierarchySettings defaults(int levels) {
+  HierarchySettings h;
+  h.levels = levels;
+  return h;
+}
+
+/// max over steps and probes of |u − u_full| / max |u_full|.
+double run_error(const std::vector<MatrixX3d>& run, const std::vector<MatrixX3d>& full) {
+  double scale = 0.0, error = 0.0;
+  for (size_t k = 0; k < full.size(); ++k)
+    for (Index p = 0; p < full[k].rows(); ++p) {
+      scale = std::max(scale, full[k].row(p).norm());
+      error = std::max(error, (run[k].row(p) - full[k].row(p)).norm());
+    }
+  return error / scale;
+}
+
+std::vector<MatrixX3d> full_run(const PokedPlate& plate) {
+  HierarchySettings h = defaults(2);
+  h.mode = HierarchyMode::full;
+  return plate.run(h);
+}
+
+TEST(AdaptiveTolerance, DefaultsStayWithinTheToleranceOfFullResolution) {
+  const PokedPlate plate;
+  const std::vector<MatrixX3d> full = full_run(plate);
+  HierarchySettings h = defaults(2);
+  h.tolerance = 0.05;
+  ToleranceReport report;
+  Index initial_tets = 0;
+  const std::vector<MatrixX3d> adaptive = plate.run(h, &report, &initial_tets);
+  const double error = run_error(adaptive, full);
+  EXPECT_LE(error, h.tolerance);
+  EXPECT_GT(initial_tets, plate.coarse.tets.rows());  // adapted before the first step
+  EXPECT_EQ(report.steps_over_tolerance, 0);
+  EXPECT_LE(report.max_estimated_error, h.tolerance);
+  // The uniform coarse cut is far off: the scene needs the refinement.
+  HierarchySettings coarse = defaults(2);
+  coarse.mode = HierarchyMode::uniform;
+  EXPECT_GT(run_error(plate.run(coarse), full), 4 * h.tolerance);
+}
+
+TEST(AdaptiveTolerance, ErrorFallsMonotonicallyWithTheTolerance) {
+  const PokedPlate plate;
+  const std::vector<MatrixX3d> full = full_run(plate);
+  double previous = 1e300;
+  for (double tolerance : {0.5, 0.2, 0.05}) {
+    HierarchySettings h = defaults(2);
+    h.tolerance = tolerance;
+    const double error = run_error(plate.run(h), full);
+    EXPECT_LE(error, previous * (1 + 1e-9)) << "tolerance " << tolerance;
+    previous = error;
+  }
+}
+
+TEST(AdaptiveTolerance, InStepRefinementRedoesStepsWithoutAnInitialAdaptation) {
+  const PokedPlate plate;
+  const std::vector<MatrixX3d> full = full_run(plate);
+  HierarchySettings h = defaults(2);
+  h.tolerance = 0.05;
+  h.initial_adaptation = false;
+  ToleranceReport report;
+  Index initial_tets = 0;
+  const std::vector<MatrixX3d> adaptive = plate.run(h, &report, &initial_tets);
+  EXPECT_EQ(initial_tets, plate.coarse.tets.rows());
+  EXPECT_GT(report.redone_steps, 0);
+  EXPECT_GT(report.redo_seconds, 0.0);
+  EXPECT_LE(run_error(adaptive, full), h.tolerance);
+}
+
+TEST(AdaptiveTolerance, AToleranceTheCutCannotMeetIsReported) {
+  const PokedPlate plate;
+  HierarchySettings h = defaults(2);
+  h.tolerance = 0.01;
+  h.criteria.max_level = 0;  // refinement refused everywhere
+  ToleranceReport report;
+  plate.run(h, &report);
+  EXPECT_GT(report.steps_over_tolerance, 0);
+  EXPECT_GT(report.max_estimated_error, h.tolerance);
+  EXPECT_GT(report.refused_refinements, 0);
+}
+
+}  // namespace
+}  // namespace strata
