@@ -180,5 +180,45 @@ TEST(CliHierarchy, FineSurfaceFollowsTheActiveCut) {
                                 deformed);
 }
 
+// The error control through the CLI: the default recovery criterion with a tolerance the cut
+// cannot meet (refinement capped at the roots) warns on stderr and reports it in stats.json.
+TEST(CliHierarchy, UnmetToleranceWarnsAndIsReported) {
+  const TempFolder folder;
+  json scene = slab_scene("adaptive");
+  scene["hierarchy"] = {{"levels", 2}, {"tolerance", 0.01}, {"max_level", 0}};
+  write_text(folder.path() / "capped.json", scene.dump(2));
+  const CliResult capped = run_strata("run capped.json --quiet", folder.path());
+  ASSERT_EQ(capped.exit_code, 0) << capped.err;
+  EXPECT_THAT(capped.err, HasSubstr("exceeded hierarchy.tolerance 0.01"));
+  const json stats = read_json(folder.path() / "out" / "capped" / "stats.json");
+  const json& h = stats["hierarchy"];
+  EXPECT_EQ(h["indicator"], "recovery");
+  EXPECT_EQ(h["tolerance"], 0.01);
+  EXPECT_FALSE(h["tolerance_met"].get<bool>());
+  EXPECT_GT(h["steps_over_tolerance"].get<long>(), 0);
+  EXPECT_GT(h["estimated_error"].get<double>(), 0.01);
+  EXPECT_EQ(h["history"]["estimated_error"].size(), h["history"]["step"].size());
+
+  // The same scene free to refine meets a loose tolerance silently.
+  scene["hierarchy"] = {{"levels", 2}, {"tolerance", 0.3}};
+  write_text(folder.path() / "free.json", scene.dump(2));
+  const CliResult free = run_strata("run free.json --quiet", folder.path());
+  ASSERT_EQ(free.exit_code, 0) << free.err;
+  EXPECT_THAT(free.err, ::testing::Not(HasSubstr("exceeded")));
+  const json free_stats = read_json(folder.path() / "out" / "free" / "stats.json");
+  EXPECT_TRUE(free_stats["hierarchy"]["tolerance_met"].get<bool>());
+  EXPECT_LE(free_stats["hierarchy"]["estimated_error"].get<double>(), 0.3);
+}
+
+TEST(CliHierarchy, BadToleranceNamesTheKey) {
+  const TempFolder folder;
+  json scene = slab_scene("adaptive");
+  scene["hierarchy"]["tolerance"] = 1.5;
+  write_text(folder.path() / "bad.json", scene.dump(2));
+  const CliResult bad = run_strata("run bad.json --quiet", folder.path());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("hierarchy.tolerance"));
+}
+
 }  // namespace
 }  // namespace strata::cli_test
