@@ -52,7 +52,9 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
     }
     const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
     const int level = state.tree.level(state.flat.tet_nodes[t]);
-    const double removed = 1.0 - std::pow(2.0, -(depth - level));
+    // The part refinement to the finest level removes, in displacement: (1 − 2^−(L−ℓ)) of the
+    // energy error, times (h_ℓ / h_0)^½ = 2^−ℓ/2 (see the header).
+    const double removed = (1.0 - std::pow(2.0, -(depth - level))) * std::pow(2.0, -0.5 * level);
     estimate.element_error_sq[t] = error_sq * removed * removed;
     raw_total += error_sq;
     total += estimate.element_error_sq[t];
