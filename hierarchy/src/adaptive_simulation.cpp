@@ -191,7 +191,9 @@ void AdaptiveSimulation::initial_adaptation() {
     const CutState state{
         *m_tree,    flat, solve->positions(), fields, m_mesh_external, solve->vertex_mass(),
         m_material, 0,    &m_load_traction};
-    if (recovery_error_estimate(state).relative_error <= m_settings.tolerance) break;
+    if (m_settings.indicator == "recovery" &&
+        recovery_error_estimate(state).relative_error <= m_settings.tolerance)
+      break;
     CutChanges changes = m_controller->decide(state, *m_cut);
     changes.coarsen.clear();
     m_report.refused_refinements += changes.refused;
@@ -505,9 +507,11 @@ void AdaptiveSimulation::record_sample() {
   sample.tets = m_cut->size();
   sample.dofs = m_simulation->embedded_model().num_dofs();
   sample.hanging = m_constrained->constraints.num_hanging();
-  const RecoveryEstimate estimate = estimate_error();
-  sample.estimated_error = estimate.relative_error;
-  sample.estimated_energy_error = estimate.relative_energy_error;
+  if (m_settings.mode != HierarchyMode::full) {  // full resolution: zero by definition
+    const RecoveryEstimate estimate = estimate_error();
+    sample.estimated_error = estimate.relative_error;
+    sample.estimated_energy_error = estimate.relative_energy_error;
+  }
   if (!m_history.empty()) {  // accepted steps (the initial sample is the cut before any step)
     m_report.max_estimated_error = std::max(m_report.max_estimated_error, sample.estimated_error);
     if (sample.estimated_error > m_settings.tolerance) ++m_report.steps_over_tolerance;
