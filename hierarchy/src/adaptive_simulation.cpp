@@ -403,7 +403,9 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     m_failed = true;
     throw;
   }
-  m_finished_counters = add(m_finished_counters, old_simulation->counters());
+  SimulationCounters old_counters = old_simulation->counters();
+  if (first_step < old_simulation->step_count()) old_counters.steps -= 1;  // a redone step
+  m_finished_counters = add(m_finished_counters, old_counters);
   old_simulation.reset();
   old_cut.reset();
   for (NodeId parent : changes.coarsen)

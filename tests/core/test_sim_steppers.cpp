@@ -77,7 +77,7 @@ TEST(Steppers, DynamicSteppersFollowFreeFall) {
     VectorXd q = box.model->rest_positions();
     VectorXd v = VectorXd::Zero(q.size());
     for (int k = 0; k < steps; ++k) {
-      const NewtonResult result = stepper->step(k * h, (k + 1) * h, q, v);
+      const NewtonResult result = stepper->step(k * h, (k + 1) * h, h, q, v);
       ASSERT_TRUE(result.converged) << traits.name;
     }
     // Every vertex falls rigidly: Δz = −½ g t² up to the method's O(h) (exact for RK4).
@@ -101,7 +101,7 @@ TEST(Steppers, FailedImplicitStepLeavesTheStartState) {
   q[0] += 0.01;  // a deformed start, so the step has work to do
   VectorXd v = VectorXd::Constant(q.size(), 0.3);
   const VectorXd q0 = q, v0 = v;
-  const NewtonResult result = stepper->step(0.0, 1e-3, q, v);
+  const NewtonResult result = stepper->step(0.0, 1e-3, 1e-3, q, v);
   ASSERT_FALSE(result.converged);
   EXPECT_EQ(q, q0);
   EXPECT_EQ(v, v0);

@@ -53,12 +53,13 @@ struct PokedPlate {
     return frames;
   }
   std::vector<MatrixX3d> run(const HierarchySettings& h, ToleranceReport* report = nullptr,
-                             Index* initial_tets = nullptr) const {
+                             Index* initial_tets = nullptr, long* steps = nullptr) const {
     AdaptiveSimulation sim(coarse, h, material(), fixed, loads, std::nullopt, Vector3d::Zero(),
                            solver());
     if (initial_tets) *initial_tets = sim.cut().size();
     std::vector<MatrixX3d> frames = run(sim);
     if (report) *report = sim.tolerance_report();
+    if (steps) *steps = sim.counters().steps;
     return frames;
   }
 };
@@ -126,9 +127,11 @@ TEST(AdaptiveTolerance, InStepRefinementRedoesStepsWithoutAnInitialAdaptation) {
   h.initial_adaptation = false;
   ToleranceReport report;
   Index initial_tets = 0;
-  const std::vector<MatrixX3d> adaptive = plate.run(h, &report, &initial_tets);
+  long steps = 0;
+  const std::vector<MatrixX3d> adaptive = plate.run(h, &report, &initial_tets, &steps);
   EXPECT_EQ(initial_tets, plate.coarse.tets.rows());
   EXPECT_GT(report.redone_steps, 0);
+  EXPECT_EQ(steps, static_cast<long>(adaptive.size()));  // a redone step counts once
   EXPECT_GT(report.redo_seconds, 0.0);
   EXPECT_LE(run_error(adaptive, full), h.tolerance);
 }

@@ -101,10 +101,13 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
     ++result.iterations;
 
     bool solved = false;
-    if (choice.try_exact()) {
+    const bool exact = choice.try_exact();
+    if (exact) {
       objective.hessian(x, hessian, false);
       reduction.restrict_matrix(hessian, reduced_hessian);
-      solved = solver.solve(reduced_hessian, -g, step);
+      // A solve answered without a factorisation (CG on a previous factor) does not prove the
+      // matrix positive definite: the step must also descend.
+      solved = solver.solve(reduced_hessian, -g, step) && g.dot(step) < 0.0;
       if (solved)
         ++result.exact_hessian_iterations;
       else
@@ -151,6 +154,12 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
       trial_energy = objective.value(trial);
       objective.gradient(trial, trial_gradient);
       trial_g = reduction.restrict_vector(trial_gradient);
+      if (!(std::isfinite(trial_energy) && trial_g.norm() < result.residual) && solved && exact) {
+        // The exact Hessian's step fails where it is not positive definite along it: retry the
+        // iteration with the projected Hessian before judging the residual stalled.
+        choice.exact_failed();
+        continue;
+      }
       if (!(std::isfinite(trial_energy) && trial_g.norm() < result.residual)) {
         // Nothing lowers E or ‖g‖: converged if the correction is at round-off level.
         if (increment <= settings.stall_tolerance * displacement_scale(settings, x))

@@ -161,7 +161,8 @@ void Simulation::advance() {
   const double t0 = time();
   const double t1 = is_static() ? static_cast<double>(m_steps + 1) / m_settings.load_steps
                                 : static_cast<double>(m_steps + 1) * m_settings.dt;
-  const NewtonResult result = m_stepper->step(t0, t1, m_x, m_v);
+  const double h = is_static() ? t1 - t0 : m_settings.dt;
+  const NewtonResult result = m_stepper->step(t0, t1, h, m_x, m_v);
   record_newton(result);
   if (!result.converged)
     throw_newton_failure(std::string(m_stepper_traits->name), result.iterations, result.residual);

@@ -38,20 +38,23 @@ long planned_steps(const SolverSettings& settings) {
   return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
 }
 
-/// The scene's simulation: a plain Simulation on the mesh, or (scene key "hierarchy") an
-/// AdaptiveSimulation on an active cut of the refinement tree over it. The runner only uses this
-/// class, so every output is written the same way for both.
+/// The scene's run (SimulationRun): a plain Simulation on the mesh, or (scene key "hierarchy") an
+/// AdaptiveSimulation on an active cut of the refinement tree over it. Stepping, the current
+/// mesh's state and the counters go through the interface; `adaptive()` gives the hierarchy's own
+/// outputs (probes through the tree, per-cell levels, the stats block).
 class SceneSimulation {
  public:
   /// Core InputErrors get the scene file as prefix.
   SceneSimulation(const Scene& scene, const TetMesh& mesh) {
     try {
       if (scene.hierarchy) {
-        m_adaptive = std::make_unique<AdaptiveSimulation>(
+        auto adaptive = std::make_unique<AdaptiveSimulation>(
             mesh, *scene.hierarchy, scene.material, scene.dirichlet_groups(), scene.forces,
             scene.ground, scene.gravity, scene.solver);
+        m_adaptive = adaptive.get();
+        m_run = std::move(adaptive);
       } else {
-        m_plain =
+        m_run =
             std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
                                          scene.forces, scene.ground, scene.gravity, scene.solver);
       }
@@ -59,18 +62,16 @@ class SceneSimulation {
       throw InputError(scene.file.string() + ": " + error.what());
     }
   }
-  void advance() { m_adaptive ? m_adaptive->advance() : m_plain->advance(); }
-  bool finished() const { return current().finished(); }
+  void advance() { m_run->advance(); }
+  bool finished() const { return m_run->finished(); }
   /// The Simulation of the current mesh (the active cut's, for a hierarchy).
-  const Simulation& current() const { return m_adaptive ? m_adaptive->simulation() : *m_plain; }
-  const AdaptiveSimulation* adaptive() const { return m_adaptive.get(); }
-  SimulationCounters counters() const {
-    return m_adaptive ? m_adaptive->counters() : m_plain->counters();
-  }
+  const Simulation& current() const { return m_run->current(); }
+  const AdaptiveSimulation* adaptive() const { return m_adaptive; }
+  SimulationCounters counters() const { return m_run->counters(); }
 
  private:
-  std::unique_ptr<Simulation> m_plain;
-  std::unique_ptr<AdaptiveSimulation> m_adaptive;
+  std::unique_ptr<SimulationRun> m_run;
+  const AdaptiveSimulation* m_adaptive = nullptr;
 };
 
 /// stats.json's "hierarchy" block: settings, the active-cut history and every cut change.

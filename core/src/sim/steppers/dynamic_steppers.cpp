@@ -17,9 +17,9 @@ BackwardEulerStepper::BackwardEulerStepper(const Problem& problem, const SolverS
           problem, settings.linear_solver,
           {settings.max_newton_iterations, settings.newton_tolerance, settings.exact_hessian}) {}
 
-NewtonResult BackwardEulerStepper::step(double t0, double t1, VectorXd& q, VectorXd& v) {
+NewtonResult BackwardEulerStepper::step(double t0, double, double h, VectorXd& q, VectorXd& v) {
   VectorXd q_step = q, v_step = v;
-  const NewtonResult result = m_integrator.step(t0, t1 - t0, q_step, v_step);
+  const NewtonResult result = m_integrator.step(t0, h, q_step, v_step);
   if (result.converged) {
     q.swap(q_step);
     v.swap(v_step);
@@ -27,13 +27,13 @@ NewtonResult BackwardEulerStepper::step(double t0, double t1, VectorXd& q, Vecto
   return result;
 }
 
-NewtonResult SymplecticEulerStepper::step(double t0, double t1, VectorXd& q, VectorXd& v) {
-  symplectic_euler_step(m_problem, t0, t1 - t0, q, v);
+NewtonResult SymplecticEulerStepper::step(double t0, double, double h, VectorXd& q, VectorXd& v) {
+  symplectic_euler_step(m_problem, t0, h, q, v);
   return explicit_result();
 }
 
-NewtonResult Rk4Stepper::step(double t0, double t1, VectorXd& q, VectorXd& v) {
-  rk4_step(m_problem, t0, t1 - t0, q, v);
+NewtonResult Rk4Stepper::step(double t0, double, double h, VectorXd& q, VectorXd& v) {
+  rk4_step(m_problem, t0, h, q, v);
   return explicit_result();
 }
 

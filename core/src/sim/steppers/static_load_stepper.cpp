@@ -7,7 +7,7 @@ StaticLoadStepper::StaticLoadStepper(const Problem& problem, const SolverSetting
           problem, settings.linear_solver,
           {settings.max_newton_iterations, settings.newton_tolerance, settings.exact_hessian}) {}
 
-NewtonResult StaticLoadStepper::step(double, double t1, VectorXd& q, VectorXd& v) {
+NewtonResult StaticLoadStepper::step(double, double t1, double, VectorXd& q, VectorXd& v) {
   VectorXd guess = q;
   if (m_has_previous) guess += q - m_previous;  // linear extrapolation along the load path
   const NewtonResult result = m_solver.solve(t1, guess);

@@ -129,13 +129,13 @@ struct ToleranceReport {
   /// Refinements the criteria asked for but could not make (max_level, element budget, explicit
   /// step veto, hysteresis) over the run.
   long refused_refinements = 0;
-  long redone_steps = 0;        ///< dynamic steps redone on a refined cut
+  long redone_steps = 0;        ///< redo passes: dynamic steps redone on a refined cut
   double redo_seconds = 0.0;    ///< wall time of the discarded attempts [s]
   int initial_refinements = 0;  ///< nodes refined by the initial adaptation
   double initial_adaptation_seconds = 0.0;
 };
 
-class AdaptiveSimulation {
+class AdaptiveSimulation final : public SimulationRun {
  public:
   /// `coarse`: the roots (validated and oriented by the caller, as for Simulation). The region
   /// loads are applied on the finest level; gravity, Dirichlet groups, ground and solver settings
@@ -144,13 +144,15 @@ class AdaptiveSimulation {
                      const Material& material, std::vector<DirichletSpec> dirichlet,
                      const std::vector<RegionLoad>& loads, std::optional<GroundPlane> ground,
                      const Vector3d& gravity, const SolverSettings& settings);
-  ~AdaptiveSimulation();
+  ~AdaptiveSimulation() override;
   AdaptiveSimulation(const AdaptiveSimulation&) = delete;
   AdaptiveSimulation& operator=(const AdaptiveSimulation&) = delete;
 
   /// One time step (or load step), then the criteria if due. Throws DivergenceError as Simulation.
-  void advance();
-  bool finished() const { return m_simulation->finished(); }
+  void advance() override;
+  bool finished() const override { return m_simulation->finished(); }
+  /// The Simulation on the current cut.
+  const Simulation& current() const override { return *m_simulation; }
   double time() const { return m_simulation->time(); }
   long step_count() const { return m_simulation->step_count(); }
 
@@ -179,7 +181,7 @@ class AdaptiveSimulation {
   const std::vector<CutChangeRecord>& changes() const { return m_changes; }
   const std::vector<CutSample>& history() const { return m_history; }
   /// Work summed over every Simulation of the run.
-  SimulationCounters counters() const;
+  SimulationCounters counters() const override;
   /// Wall time spent in cut changes (bookkeeping) and in Simulation::advance [s].
   double bookkeeping_seconds() const { return m_bookkeeping_seconds; }
   double stepping_seconds() const { return m_stepping_seconds; }

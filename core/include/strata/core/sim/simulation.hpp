@@ -33,6 +33,7 @@
 #include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/simulation_run.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 
 namespace strata {
@@ -85,7 +86,7 @@ struct SimulationCounters {
   double max_residual_ratio = 0.0;
 };
 
-class Simulation {
+class Simulation final : public SimulationRun {
  public:
   /// `mesh` must be validated and positively oriented (validate_tet_mesh, orient_tets).
   /// Throws InputError for a vertex without tets, invalid material / settings / regions / ground,
@@ -94,7 +95,7 @@ class Simulation {
              const std::vector<RegionLoad>& loads, const std::optional<GroundPlane>& ground,
              const Vector3d& gravity, const SolverSettings& settings,
              SimulationOptions options = {});
-  ~Simulation();
+  ~Simulation() override;
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
@@ -106,7 +107,7 @@ class Simulation {
   /// One time step of `dt` (dynamic) or one load step (static). Throws DivergenceError naming the
   /// step and time (or load factor) if the state diverges or Newton fails; std::logic_error if
   /// called when finished().
-  void advance();
+  void advance() override;
   /// Static mode only: re-solves the equilibrium at the current load factor, starting from the
   /// current state (e.g. after a driver carried the state over to a new mesh with
   /// SimulationOptions::first_step = the step just taken). The step count is unchanged; the next
@@ -115,7 +116,7 @@ class Simulation {
   void resolve_static();
   /// Dynamic: t ≥ duration (up to 10⁻⁹ dt; the last step is not shortened, so the run takes
   /// ⌈duration/dt⌉ steps). Static: all load_steps done.
-  bool finished() const;
+  bool finished() const override;
 
   /// Mesh positions x = P q, 3·#V [m].
   const VectorXd& positions() const { return m_embedded->is_identity() ? m_x : m_mesh_x; }
@@ -141,7 +142,9 @@ class Simulation {
   /// Potential of the dead loads −s_f f_extᵀ(x − X) [J] (s_f = load factor in static mode, 1 in
   /// dynamic mode).
   double external_potential_energy() const;
-  SimulationCounters counters() const;
+  SimulationCounters counters() const override;
+  /// A plain run is its own current simulation.
+  const Simulation& current() const override { return *this; }
 
   const TetMesh& mesh() const { return m_mesh; }
   const ElasticModel& model() const { return *m_model; }  ///< on the mesh (3·#V)

@@ -11,7 +11,7 @@ namespace strata {
 class BackwardEulerStepper final : public TimeStepper {
  public:
   BackwardEulerStepper(const Problem& problem, const SolverSettings& settings);
-  NewtonResult step(double t0, double t1, VectorXd& q, VectorXd& v) override;
+  NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
   const SpdSolver* linear_solver() const override { return &m_integrator.linear_solver(); }
   const EnergySum* energy() const override { return &m_integrator.energy(); }
 
@@ -22,7 +22,7 @@ class BackwardEulerStepper final : public TimeStepper {
 class SymplecticEulerStepper final : public TimeStepper {
  public:
   explicit SymplecticEulerStepper(const Problem& problem) : m_problem(problem) {}
-  NewtonResult step(double t0, double t1, VectorXd& q, VectorXd& v) override;
+  NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
 
  private:
   const Problem& m_problem;
@@ -31,7 +31,7 @@ class SymplecticEulerStepper final : public TimeStepper {
 class Rk4Stepper final : public TimeStepper {
  public:
   explicit Rk4Stepper(const Problem& problem) : m_problem(problem) {}
-  NewtonResult step(double t0, double t1, VectorXd& q, VectorXd& v) override;
+  NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
 
  private:
   const Problem& m_problem;

@@ -11,7 +11,7 @@ namespace strata {
 class StaticLoadStepper final : public TimeStepper {
  public:
   StaticLoadStepper(const Problem& problem, const SolverSettings& settings);
-  NewtonResult step(double t0, double t1, VectorXd& q, VectorXd& v) override;
+  NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
   NewtonResult resolve(double t, VectorXd& q, VectorXd& v) override;
   void reset_history() override { m_has_previous = false; }
   const SpdSolver* linear_solver() const override { return &m_solver.linear_solver(); }

@@ -21,9 +21,10 @@ namespace strata {
 class TimeStepper {
  public:
   virtual ~TimeStepper() = default;
-  /// Advances (q, v) (3·#Q each) from t₀ to t₁. On a result that did not converge, q and v are
-  /// left at the start of the step.
-  virtual NewtonResult step(double t0, double t1, VectorXd& q, VectorXd& v) = 0;
+  /// Advances (q, v) (3·#Q each) from t₀ to t₁ = t₀ + h; h is passed as given (the scene's dt
+  /// exactly, not t₁ − t₀ with its round-off). On a result that did not converge, q and v are left
+  /// at the start of the step.
+  virtual NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) = 0;
   /// Re-solves the state at t (static load stepping after the state moved to a new cut); other
   /// steppers throw std::logic_error.
   virtual NewtonResult resolve(double t, VectorXd& q, VectorXd& v);
