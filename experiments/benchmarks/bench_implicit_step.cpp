@@ -29,9 +29,7 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
 
   const VectorXd vertex_mass = lumped_vertex_mass(model.rest_data().rest_volume, model.tets(),
                                                   model.num_vertices(), mat.density);
-  VectorXd dof_mass(model.num_dofs());
-  for (Index v = 0; v < model.num_vertices(); ++v)
-    dof_mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
+  const VectorXd dof_mass = per_dof_mass(vertex_mass);
   const VectorXd f_ext = gravity_forces(vertex_mass, Vector3d(0.0, 0.0, -9.81));
 
   const double tolerance = region_tolerance(c.mesh.vertices);

@@ -188,11 +188,12 @@ void AdaptiveSimulation::initial_adaptation() {
       break;
     }
     const TetFields fields = solve->model().tet_fields(solve->positions());
-    const CutState state{
+    CutState state{
         *m_tree,    flat, solve->positions(), fields, m_mesh_external, solve->vertex_mass(),
         m_material, 0,    &m_load_traction};
-    if (m_settings.indicator == "recovery" &&
-        recovery_error_estimate(state).relative_error <= m_settings.tolerance)
+    const RecoveryEstimate estimate = recovery_error_estimate(state);
+    state.recovery_estimate = &estimate;
+    if (m_settings.indicator == "recovery" && estimate.relative_error <= m_settings.tolerance)
       break;
     CutChanges changes = m_controller->decide(state, *m_cut);
     changes.coarsen.clear();
@@ -333,6 +334,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   state.solution_energy_scale = m_energy_scale;
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
+  state.recovery_estimate = &m_estimate;
   // The recovery criterion refines only while the run's estimate exceeds the tolerance.
   const bool within_tolerance =
       m_settings.indicator == "recovery" && m_estimate.relative_error <= m_settings.tolerance;

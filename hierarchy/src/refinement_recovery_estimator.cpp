@@ -75,7 +75,10 @@ RecoveryIndicator::RecoveryIndicator(double tolerance) : m_tolerance(tolerance) 
 }
 
 void RecoveryIndicator::evaluate(const CutState& state, VectorXd& eta) const {
-  const RecoveryEstimate estimate = recovery_error_estimate(state);
+  RecoveryEstimate computed;
+  if (state.recovery_estimate == nullptr) computed = recovery_error_estimate(state);
+  const RecoveryEstimate& estimate =
+      state.recovery_estimate != nullptr ? *state.recovery_estimate : computed;
   const Index n = estimate.element_error_sq.size();
   eta.setZero(n);
   if (estimate.reference_energy_sq <= 0.0 || n == 0) return;

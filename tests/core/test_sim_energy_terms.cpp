@@ -7,10 +7,7 @@
 #include <random>
 
 #include "fem_test_utils.hpp"
-#include "strata/core/fem/elastic_model.hpp"
-#include "strata/core/fem/lumped_mass.hpp"
-#include "strata/core/mesh/tet_mesh.hpp"
-#include "strata/core/sim/embedded_model.hpp"
+#include "problem_test_utils.hpp"
 #include "strata/core/sim/energy/elastic_term.hpp"
 #include "strata/core/sim/energy/energy_term.hpp"
 #include "strata/core/sim/energy/external_work_term.hpp"
@@ -21,25 +18,21 @@
 namespace strata {
 namespace {
 
-/// A 2×1×1-cell box (12 tets) with its model, masses, loads and a deformed state.
-struct TermFixture {
-  TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.1, 0.1), {2, 1, 1});
+Material term_material(MaterialModel kind) {
   Material material;
-  std::unique_ptr<ElasticModel> model;
-  std::unique_ptr<EmbeddedElasticModel> embedded;
-  VectorXd mass, forces, state, velocity;
+  material.model = kind;
+  material.youngs_modulus = 1e5;
+  material.poisson_ratio = 0.3;
+  return material;
+}
 
-  explicit TermFixture(MaterialModel kind) {
-    material.model = kind;
-    material.youngs_modulus = 1e5;
-    material.poisson_ratio = 0.3;
-    model = std::make_unique<ElasticModel>(mesh.vertices, mesh.tets, material);
-    embedded = std::make_unique<EmbeddedElasticModel>(*model);
-    const VectorXd vertex_mass = lumped_vertex_mass(model->rest_data().rest_volume, mesh.tets,
-                                                    mesh.vertices.rows(), material.density);
-    mass.resize(model->num_dofs());
-    for (Index v = 0; v < vertex_mass.size(); ++v)
-      mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
+/// A 2×1×1-cell box (12 tets) with its model, masses, random loads and a deformed state.
+struct TermFixture : testing::BoxProblem {
+  VectorXd forces, state, velocity;
+
+  explicit TermFixture(MaterialModel kind)
+      : BoxProblem(Vector3d(0.2, 0.1, 0.1), {2, 1, 1}, term_material(kind), Vector3d::Zero(),
+                   false) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> uniform(-1.0, 1.0);
     state = model->rest_positions();

@@ -8,58 +8,30 @@
 #include <memory>
 #include <sstream>
 
-#include "strata/core/fem/elastic_model.hpp"
-#include "strata/core/fem/lumped_mass.hpp"
-#include "strata/core/mesh/tet_mesh.hpp"
-#include "strata/core/sim/dirichlet.hpp"
-#include "strata/core/sim/embedded_model.hpp"
+#include "problem_test_utils.hpp"
 #include "strata/core/sim/energy/elastic_term.hpp"
 #include "strata/core/sim/energy/external_work_term.hpp"
-#include "strata/core/sim/loads.hpp"
-#include "strata/core/sim/problem.hpp"
-#include "strata/core/sim/region.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/static_solver.hpp"
 
 namespace strata {
 namespace {
 
+Material stvk_material() {
+  Material material;
+  material.model = MaterialModel::stvk;
+  material.youngs_modulus = 5e6;
+  material.poisson_ratio = 0.3;
+  material.density = 1000.0;
+  return material;
+}
+
 /// A 1 m × 0.1 m × 0.1 m StVK cantilever clamped at x = 0 under gravity, bending by about 10 %
 /// of its length at full load, with its Problem.
-struct Cantilever {
-  TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(1, 0.1, 0.1), {16, 2, 2});
-  Material material;
-  std::unique_ptr<ElasticModel> model;
-  std::unique_ptr<EmbeddedElasticModel> embedded;
-  VectorXd mass, external;
-  std::vector<DirichletGroup> groups;
-  std::vector<char> constrained;
-  std::unique_ptr<Problem> problem;
-
-  Cantilever() {
-    material.model = MaterialModel::stvk;
-    material.youngs_modulus = 5e6;
-    material.poisson_ratio = 0.3;
-    material.density = 1000.0;
-    model = std::make_unique<ElasticModel>(mesh.vertices, mesh.tets, material);
-    embedded = std::make_unique<EmbeddedElasticModel>(*model);
-    const VectorXd vertex_mass = lumped_vertex_mass(model->rest_data().rest_volume, mesh.tets,
-                                                    mesh.vertices.rows(), material.density);
-    mass.resize(model->num_dofs());
-    for (Index v = 0; v < vertex_mass.size(); ++v)
-      mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
-    external = gravity_forces(vertex_mass, Vector3d(0, 0, -9.81));
-    DirichletSpec clamp;
-    clamp.name = "fixed[0]";
-    clamp.region = PlaneRegion{Vector3d::Zero(), Vector3d::UnitX(), 0.0};
-    groups = resolve_dirichlet_groups({clamp}, mesh.vertices, region_tolerance(mesh.vertices));
-    constrained = dirichlet_dof_mask(groups, mesh.vertices.rows());
-    problem.reset(new Problem{.model = *embedded,
-                              .dof_mass = mass,
-                              .external_forces = external,
-                              .groups = groups,
-                              .constrained = constrained});
-  }
+struct Cantilever : testing::BoxProblem {
+  Cantilever()
+      : BoxProblem(Vector3d(1, 0.1, 0.1), {16, 2, 2}, stvk_material(), Vector3d(0, 0, -9.81),
+                   true) {}
 
   /// Solves load steps 1/n … 1 from rest, each from the previous solution; returns the results.
   std::vector<NewtonResult> solve(int load_steps, NewtonControls controls, VectorXd& q) const {

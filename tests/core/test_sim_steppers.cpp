@@ -6,45 +6,22 @@
 #include <set>
 #include <string>
 
-#include "strata/core/fem/elastic_model.hpp"
-#include "strata/core/fem/lumped_mass.hpp"
-#include "strata/core/mesh/tet_mesh.hpp"
-#include "strata/core/sim/embedded_model.hpp"
-#include "strata/core/sim/loads.hpp"
-#include "strata/core/sim/problem.hpp"
+#include "problem_test_utils.hpp"
 #include "strata/core/sim/steppers/time_stepper.hpp"
 
 namespace strata {
 namespace {
 
-/// A free box under gravity, without constraints.
-struct FreeBox {
-  TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.1, 0.1), {2, 1, 1});
+Material neohookean() {
   Material material;
-  std::unique_ptr<ElasticModel> model;
-  std::unique_ptr<EmbeddedElasticModel> embedded;
-  VectorXd mass, gravity;
-  std::vector<DirichletGroup> groups;
-  std::vector<char> constrained;
-  std::unique_ptr<Problem> problem;
+  material.model = MaterialModel::neohookean;
+  return material;
+}
 
-  FreeBox() {
-    material.model = MaterialModel::neohookean;
-    model = std::make_unique<ElasticModel>(mesh.vertices, mesh.tets, material);
-    embedded = std::make_unique<EmbeddedElasticModel>(*model);
-    const VectorXd vertex_mass = lumped_vertex_mass(model->rest_data().rest_volume, mesh.tets,
-                                                    mesh.vertices.rows(), material.density);
-    mass.resize(model->num_dofs());
-    for (Index v = 0; v < vertex_mass.size(); ++v)
-      mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
-    gravity = gravity_forces(vertex_mass, Vector3d(0, 0, -9.81));
-    constrained.assign(model->num_dofs(), 0);
-    problem.reset(new Problem{.model = *embedded,
-                              .dof_mass = mass,
-                              .external_forces = gravity,
-                              .groups = groups,
-                              .constrained = constrained,
-                              .diagonal = 0.25});
+/// A free box under gravity, without constraints.
+struct FreeBox : testing::BoxProblem {
+  FreeBox()
+      : BoxProblem(Vector3d(0.2, 0.1, 0.1), {2, 1, 1}, neohookean(), Vector3d(0, 0, -9.81), false) {
   }
 };
 

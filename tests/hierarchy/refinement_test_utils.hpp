@@ -109,6 +109,15 @@ inline CutSnapshot make_snapshot(const ActiveCut& cut, const Material& material,
   return s;
 }
 
+/// The mixed cut of the criteria tests: a few roots refined, one child refined again.
+inline ActiveCut mixed_cut(TetTree& tree) {
+  ActiveCut cut(tree);
+  for (const NodeId r : {3, 40, 41, 100, 200})
+    cut.refine(r);
+  cut.refine(tree.child(40, 2));
+  return cut;
+}
+
 /// No displacement.
 inline Vector3d no_motion(const Vector3d&) {
   return Vector3d::Zero();

@@ -15,20 +15,12 @@ using test::affine_gradient;
 using test::bump;
 using test::kSlabMax;
 using test::make_snapshot;
+using test::mixed_cut;
 using test::node_centroid;
 using test::PointLoad;
 using test::set_surface_tractions;
 using test::slab;
 using test::test_material;
-
-// The mixed cut used throughout: a few roots refined, one child refined again.
-ActiveCut mixed_cut(TetTree& tree) {
-  ActiveCut cut(tree);
-  for (const NodeId r : {3, 40, 41, 100, 200})
-    cut.refine(r);
-  cut.refine(tree.child(40, 2));
-  return cut;
-}
 
 TEST(ForceIndicator, UniformStressWithItsTractionsStaysAtOrBelowOne) {
   TetTree tree(slab(), 2);

@@ -13,21 +13,19 @@ namespace strata {
 namespace {
 
 using test::make_snapshot;
+using test::mixed_cut;
 using test::node_centroid;
 using test::slab;
 using test::test_material;
 
-ActiveCut refined_corner_cut(TetTree& tree) {
-  ActiveCut cut(tree);
-  for (const NodeId r : {3, 40, 41, 100, 200})
-    cut.refine(r);
-  cut.refine(tree.child(40, 2));
-  return cut;
+/// Uniaxial strain switching from 0 to 1 % across the plane x = 0.4: a strain jump there.
+Vector3d kink(const Vector3d& X) {
+  return Vector3d(0.01 * std::max(0.0, X.x() - 0.4), 0, 0);
 }
 
 TEST(RecoveryEstimator, ZeroForAffineFieldsOnAMixedCut) {
   TetTree tree(slab(), 2);
-  const ActiveCut cut = refined_corner_cut(tree);
+  const ActiveCut cut = mixed_cut(tree);
   Matrix3d G;
   G << 0.01, 0.002, -0.003, 0.001, -0.004, 0.002, 0.0, 0.003, 0.006;
   const auto affine = [&](const Vector3d& X) -> Vector3d { return G * X + Vector3d(1, 2, 3); };
@@ -53,10 +51,6 @@ TEST(RecoveryEstimator, ZeroOnTheFinestLevel) {
 TEST(RecoveryEstimator, PeaksAtAKinkOfTheField) {
   TetTree tree(slab(), 2);
   const ActiveCut cut = ActiveCut::uniform(tree, 0);
-  // Uniaxial strain switching from 0 to 1 % across the plane x = 0.4: a strain jump there.
-  const auto kink = [](const Vector3d& X) -> Vector3d {
-    return Vector3d(0.01 * std::max(0.0, X.x() - 0.4), 0, 0);
-  };
   const test::CutSnapshot s = make_snapshot(cut, test_material(), kink, {});
   const RecoveryEstimate estimate = recovery_error_estimate(s.state());
   EXPECT_GT(estimate.relative_error, 0.05);
@@ -84,9 +78,6 @@ TEST(RecoveryEstimator, FallsAsAUniformCutIsRefined) {
 TEST(RecoveryIndicator, MarksTetsAboveTheirShareOfTheTolerance) {
   TetTree tree(slab(), 2);
   const ActiveCut cut = ActiveCut::uniform(tree, 0);
-  const auto kink = [](const Vector3d& X) -> Vector3d {
-    return Vector3d(0.01 * std::max(0.0, X.x() - 0.4), 0, 0);
-  };
   const test::CutSnapshot s = make_snapshot(cut, test_material(), kink, {});
   const RecoveryEstimate estimate = recovery_error_estimate(s.state());
   VectorXd eta;

@@ -11,4 +11,11 @@ VectorXd lumped_vertex_mass(ConstRef<VectorXd> rest_volume, ConstRef<MatrixX4i> 
   return mass;
 }
 
+VectorXd per_dof_mass(ConstRef<VectorXd> vertex_mass) {
+  VectorXd mass(3 * vertex_mass.size());
+  for (Index v = 0; v < vertex_mass.size(); ++v)
+    mass.segment<3>(3 * v).setConstant(vertex_mass[v]);
+  return mass;
+}
+
 }  // namespace strata

@@ -59,9 +59,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   m_vertex_mass = lumped_vertex_mass(m_model->rest_data().rest_volume, m_mesh.tets, num_vertices,
                                      m_material.density);
   m_dof_vertex_mass = m_embedded->reduce_vertex_scalar(m_vertex_mass);
-  m_dof_mass.resize(3 * num_dof_vertices);
-  for (Index v = 0; v < num_dof_vertices; ++v)
-    m_dof_mass.segment<3>(3 * v).setConstant(m_dof_vertex_mass[v]);
+  m_dof_mass = per_dof_mass(m_dof_vertex_mass);
 
   const auto [lo, hi] = bounding_box(m_mesh.vertices);
   m_diagonal = (hi - lo).norm();

@@ -16,18 +16,7 @@ StaticSolver::StaticSolver(const Problem& problem, LinearSolverKind solver, Newt
   m_energy.emplace<ElasticTerm>(problem.model);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.ground != nullptr)
-    m_ground = &m_energy.emplace<GroundPenaltyTerm>(*problem.ground, problem.ground_stiffness);
-}
-
-double StaticSolver::potential(double load_factor, const VectorXd& q) {
-  m_external->set_load_factor(load_factor);
-  return m_energy.value(q);
-}
-
-VectorXd StaticSolver::contact_forces(const VectorXd& q) const {
-  VectorXd gradient = VectorXd::Zero(q.size());
-  if (m_ground != nullptr) m_ground->add_gradient(q, gradient);
-  return -gradient;
+    m_energy.emplace<GroundPenaltyTerm>(*problem.ground, problem.ground_stiffness);
 }
 
 NewtonResult StaticSolver::solve(double load_factor, VectorXd& q) {

@@ -12,6 +12,8 @@
 
 namespace strata {
 
+struct RecoveryEstimate;
+
 /// A snapshot of the simulation on the flattened active cut `flat` of `tree` (#V vertices,
 /// #T tets). The referenced objects and the viewed vectors must outlive the snapshot.
 ///
@@ -45,6 +47,9 @@ struct CutState {
   /// over the run so far, so that the first small-strain steps of a run are not judged relative
   /// to their own tiny deformation. 0: the state's own.
   double solution_energy_scale = 0.0;
+  /// Optional: the recovery estimate of this very state (refinement_recovery_estimator.hpp),
+  /// when the driver has computed it already; the recovery indicator then reuses it.
+  const RecoveryEstimate* recovery_estimate = nullptr;
 };
 
 }  // namespace strata

@@ -9,4 +9,7 @@ namespace strata {
 VectorXd lumped_vertex_mass(ConstRef<VectorXd> rest_volume, ConstRef<MatrixX4i> tets,
                             Index num_vertices, double density);
 
+/// The same masses per DOF: each vertex's mass on its three coordinates, 3·#V entries.
+VectorXd per_dof_mass(ConstRef<VectorXd> vertex_mass);
+
 }  // namespace strata

@@ -32,11 +32,6 @@ class StaticSolver {
   /// are overwritten with the targets at s = λ). `q` is updated in place.
   NewtonResult solve(double load_factor, VectorXd& q);
 
-  /// Total potential Π(q) at load factor λ.
-  double potential(double load_factor, const VectorXd& q);
-  /// Ground penalty forces −∂Φ/∂q at q (zero vector without ground).
-  VectorXd contact_forces(const VectorXd& q) const;
-
   const EnergySum& energy() const { return m_energy; }
   const SpdSolver& linear_solver() const { return m_solver; }
 
@@ -47,7 +42,6 @@ class StaticSolver {
   NewtonControls m_controls;
   EnergySum m_energy;
   ExternalWorkTerm* m_external = nullptr;
-  const EnergyTerm* m_ground = nullptr;
 };
 
 }  // namespace strata
