@@ -10,6 +10,7 @@
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/region.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
+#include "strata/hierarchy/cut_levels.hpp"
 #include "strata/hierarchy/cut_state.hpp"
 #include "strata/hierarchy/cut_transfer.hpp"
 #include "strata/hierarchy/red_refinement.hpp"
@@ -67,6 +68,9 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.factorizations += b.factorizations;
   a.linear_iterations += b.linear_iterations;
   a.reused_factor_solves += b.reused_factor_solves;
+  a.multigrid_setups += b.multigrid_setups;
+  a.multigrid_setup_seconds += b.multigrid_setup_seconds;
+  a.linear_solver = b.linear_solver;
   a.exact_hessian_iterations += b.exact_hessian_iterations;
   a.projected_hessian_iterations += b.projected_hessian_iterations;
   a.increment_converged_steps += b.increment_converged_steps;
@@ -259,6 +263,7 @@ void AdaptiveSimulation::rebuild(long first_step) {
   options.dof_vertices = constraints.free_vertices();
   options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads, &m_load_traction);
   options.first_step = first_step;
+  options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
   m_mesh_external = options.extra_mesh_forces;
   m_simulation =
       std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet, std::vector<RegionLoad>{},

@@ -63,6 +63,18 @@ EmbeddedElasticModel::EmbeddedElasticModel(const ElasticModel& model,
       throw InputError("embedding: DOF vertex " + std::to_string(q) +
                        " has no identity row (mesh vertex " + std::to_string(v) + ")");
   }
+  // C = I (every vertex a DOF vertex, in order; with the identity rows above, #V non-zeros
+  // leave no room for anything else): the identity path, without a reduced pattern.
+  bool in_order = m_num_dof_vertices == num_vertices && m_C.nonZeros() == num_vertices;
+  for (Index q = 0; in_order && q < m_num_dof_vertices; ++q)
+    in_order = m_dof_vertices[q] == q;
+  if (in_order) {
+    m_identity = true;
+    m_C.resize(0, 0);
+    m_CT.resize(0, 0);
+    m_rest_positions = model.rest_positions();
+    return;
+  }
   m_rest_positions.resize(3 * m_num_dof_vertices);
   for (Index q = 0; q < m_num_dof_vertices; ++q)
     m_rest_positions.segment<3>(3 * q) = model.rest_positions().segment<3>(3 * m_dof_vertices[q]);

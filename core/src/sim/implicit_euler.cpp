@@ -12,6 +12,7 @@ ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
       m_reduction(problem.model.stiffness_pattern(), problem.constrained),
       m_controls(controls),
       m_energy(problem.model.stiffness_pattern()) {
+  m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_inertia = &m_energy.emplace<InertiaTerm>(problem.dof_mass);
   m_energy.emplace<ElasticTerm>(problem.model);
   m_energy.emplace<ExternalWorkTerm>(problem.external_forces);

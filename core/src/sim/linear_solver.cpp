@@ -13,7 +13,10 @@ struct SpdSolver::Impl {
       cg;
 };
 
-SpdSolver::SpdSolver(LinearSolverKind kind) : m_impl(std::make_unique<Impl>()), m_kind(kind) {
+SpdSolver::SpdSolver(LinearSolverKind kind)
+    : m_impl(std::make_unique<Impl>()),
+      m_requested(kind),
+      m_kind(kind == LinearSolverKind::cg ? kind : LinearSolverKind::cholmod) {
   m_impl->cg.setTolerance(1e-12);
   // A failed factorisation is an expected outcome (Newton then projects the Hessian): no
   // CHOLMOD warning on stderr.
@@ -22,11 +25,34 @@ SpdSolver::SpdSolver(LinearSolverKind kind) : m_impl(std::make_unique<Impl>()), 
 
 SpdSolver::~SpdSolver() = default;
 
+void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs) {
+  const LinearSolverKind requested = m_requested;
+  m_multigrid.reset();
+  m_multigrid_stale = true;
+  const bool has_levels = spaces != nullptr && !spaces->empty();
+  const bool multigrid =
+      has_levels && (requested == LinearSolverKind::multigrid ||
+                     (requested == LinearSolverKind::automatic &&
+                      static_cast<Index>(free_dofs.size()) >= kMultigridMinDofs));
+  if (multigrid) {
+    m_kind = LinearSolverKind::multigrid;
+    m_multigrid =
+        std::make_unique<MultigridPreconditioner>(free_dof_prolongations(*spaces, free_dofs));
+  } else {
+    m_kind = requested == LinearSolverKind::cg ? LinearSolverKind::cg : LinearSolverKind::cholmod;
+  }
+}
+
+int SpdSolver::multigrid_levels() const {
+  return m_multigrid != nullptr ? m_multigrid->num_levels() : 0;
+}
+
 bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
   if (A.rows() == 0) {
     x.resize(0);
     return true;
   }
+  if (m_kind == LinearSolverKind::multigrid) return solve_multigrid(A, b, x);
   if (m_kind == LinearSolverKind::cholmod) {
     if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) {
       m_impl->cholmod.analyzePattern(A);
@@ -66,7 +92,7 @@ bool SpdSolver::solve_with_previous_factor(const SparseMatrixd& A, ConstRef<Vect
   const double b_norm = b.norm();
   x.setZero(b.size());
   if (b_norm == 0.0) return true;
-  const double target = 1e-10 * b_norm;
+  const double target = m_relative_tolerance * b_norm;
   VectorXd r = b;
   VectorXd z = m_impl->cholmod.solve(r);
   VectorXd p = z;
@@ -91,6 +117,79 @@ bool SpdSolver::solve_with_previous_factor(const SparseMatrixd& A, ConstRef<Vect
     rz = rz_next;
   }
   return false;
+}
+
+bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
+  if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) {
+    m_rows = A.rows();
+    m_nonzeros = A.nonZeros();
+    m_multigrid_stale = true;
+  }
+  bool fresh = false;
+  if (m_multigrid_stale) {
+    ++m_multigrid_setups;
+    ++m_factorizations;
+    const bool ok = m_multigrid->setup(A);
+    m_multigrid_setup_seconds += m_multigrid->setup_seconds();
+    if (!ok) return false;  // the coarsest Galerkin operator is not positive definite
+    m_multigrid_stale = false;
+    m_iterations_after_setup = -1;
+    fresh = true;
+  } else {
+    m_multigrid->update_finest(A);
+  }
+  int iterations = multigrid_pcg(A, b, x);
+  if (iterations == -1 && !fresh) {
+    // Stale coarse levels: set up on this matrix and try once more.
+    ++m_multigrid_setups;
+    ++m_factorizations;
+    const bool ok = m_multigrid->setup(A);
+    m_multigrid_setup_seconds += m_multigrid->setup_seconds();
+    if (!ok) {
+      m_multigrid_stale = true;
+      return false;
+    }
+    m_iterations_after_setup = -1;
+    iterations = multigrid_pcg(A, b, x);
+  }
+  if (iterations < 0) {
+    m_multigrid_stale = true;
+    return false;
+  }
+  if (m_iterations_after_setup < 0)
+    m_iterations_after_setup = iterations;
+  else if (iterations > 2 * m_iterations_after_setup + 4)
+    m_multigrid_stale = true;
+  return true;
+}
+
+int SpdSolver::multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
+  constexpr int kMaxIterations = 500;
+  const double b_norm = b.norm();
+  x.setZero(b.size());
+  if (b_norm == 0.0) return 0;
+  const double target = m_relative_tolerance * b_norm;
+  VectorXd r = b;
+  VectorXd z(b.size()), Ap(b.size());
+  m_multigrid->apply(r, z);
+  VectorXd p = z;
+  double rz = r.dot(z);
+  for (int k = 0; k < kMaxIterations; ++k) {
+    symmetric_product(A, p, Ap);
+    const double curvature = p.dot(Ap);
+    if (!(rz > 0.0)) return -1;  // the preconditioner, not A, is not positive definite
+    if (!(curvature > 0.0)) return -2;
+    const double alpha = rz / curvature;
+    x += alpha * p;
+    r -= alpha * Ap;
+    ++m_cg_iterations;
+    if (r.norm() <= target) return x.allFinite() ? k + 1 : -1;
+    m_multigrid->apply(r, z);
+    const double rz_next = r.dot(z);
+    p = z + (rz_next / rz) * p;
+    rz = rz_next;
+  }
+  return -1;
 }
 
 }  // namespace strata

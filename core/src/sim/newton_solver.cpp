@@ -51,6 +51,37 @@ class HessianChoice {
   int m_skip = 0;
 };
 
+/// Relative tolerance of each iterative linear solve (inexact Newton, Eisenstat & Walker 1996,
+/// choice 2 with γ = 0.9, α = 2 and their safeguard): η_k = γ (‖g_k‖ / ‖g_{k−1}‖)², at most
+/// kMaxForcing (and kMaxForcing for the first solve); never tighter than needed to bring the
+/// residual to half the target in one step, never tighter than 10⁻¹². Near the solution η follows
+/// ‖g‖, which keeps Newton's convergence quadratic.
+class InexactNewtonForcing {
+ public:
+  static constexpr double kMaxForcing = 1e-4;
+  explicit InexactNewtonForcing(double target) : m_target(target) {}
+  double next(double residual) {
+    double eta = kMaxForcing;
+    if (m_previous_residual > 0.0) {
+      const double ratio = residual / m_previous_residual;
+      eta = 0.9 * ratio * ratio;
+      const double safeguard = 0.9 * m_previous_eta * m_previous_eta;
+      if (safeguard > 0.1) eta = std::max(eta, safeguard);
+      eta = std::min(eta, kMaxForcing);
+    }
+    if (residual > 0.0) eta = std::max(eta, std::min(0.5, 0.5 * m_target / residual));
+    eta = std::max(eta, 1e-12);
+    m_previous_residual = residual;
+    m_previous_eta = eta;
+    return eta;
+  }
+
+ private:
+  double m_target;
+  double m_previous_residual = 0.0;
+  double m_previous_eta = 0.0;
+};
+
 }  // namespace
 
 std::string to_string(NewtonCriterion criterion) {
@@ -88,17 +119,19 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
   const double target =
       std::max(settings.tolerance * settings.force_scale, settings.residual_floor);
   result.residual_target = target;
-  HessianChoice choice(settings.exact_hessian && solver.kind() == LinearSolverKind::cholmod);
+  HessianChoice choice(settings.exact_hessian && solver.detects_indefinite());
   auto finish = [&](NewtonCriterion criterion) {
     result.converged = true;
     result.criterion = criterion;
     return result;
   };
+  InexactNewtonForcing forcing(target);
   while (true) {
     if (result.residual <= target || reduction.num_free() == 0)
       return finish(NewtonCriterion::residual);
     if (result.iterations >= settings.max_iterations) return result;
     ++result.iterations;
+    solver.set_relative_tolerance(forcing.next(result.residual));
 
     bool solved = false;
     const bool exact = choice.try_exact();

@@ -86,6 +86,13 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
 
   m_first_step = options.first_step;
   m_steps = m_first_step;
+  if (!options.nested_spaces.empty()) {
+    if (options.nested_spaces.num_fine_vertices() != num_dof_vertices)
+      throw InputError("simulation: nested_spaces must end on the " +
+                       std::to_string(num_dof_vertices) + " DOF vertices");
+    options.nested_spaces.check();
+    m_nested = std::move(options.nested_spaces);
+  }
   m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
@@ -99,7 +106,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .ramp_time = ramp_time,
                              .diagonal = m_diagonal,
                              .ground = m_ground ? &*m_ground : nullptr,
-                             .ground_stiffness = m_ground_stiffness});
+                             .ground_stiffness = m_ground_stiffness,
+                             .nested_spaces = m_nested.empty() ? nullptr : &m_nested});
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
   if (is_static()) {
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), 0.0, m_x, m_v);
@@ -269,6 +277,9 @@ SimulationCounters Simulation::counters() const {
     counters.factorizations = solver->factorizations();
     counters.linear_iterations = solver->cg_iterations();
     counters.reused_factor_solves = solver->reused_factor_solves();
+    counters.multigrid_setups = solver->multigrid_setups();
+    counters.multigrid_setup_seconds = solver->multigrid_setup_seconds();
+    counters.linear_solver = solver->kind();
   }
   return counters;
 }

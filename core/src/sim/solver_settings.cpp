@@ -23,7 +23,17 @@ std::string to_string(Integrator integrator) {
 }
 
 std::string to_string(LinearSolverKind kind) {
-  return kind == LinearSolverKind::cholmod ? "cholmod" : "cg";
+  switch (kind) {
+    case LinearSolverKind::cholmod:
+      return "cholmod";
+    case LinearSolverKind::cg:
+      return "cg";
+    case LinearSolverKind::multigrid:
+      return "multigrid";
+    case LinearSolverKind::automatic:
+      return "auto";
+  }
+  return "?";
 }
 
 SimulationMode simulation_mode_from_string(const std::string& name) {
@@ -43,7 +53,9 @@ Integrator integrator_from_string(const std::string& name) {
 LinearSolverKind linear_solver_from_string(const std::string& name) {
   if (name == "cholmod") return LinearSolverKind::cholmod;
   if (name == "cg") return LinearSolverKind::cg;
-  throw InputError("unknown linear solver '" + name + "' (valid: cholmod, cg)");
+  if (name == "multigrid") return LinearSolverKind::multigrid;
+  if (name == "auto") return LinearSolverKind::automatic;
+  throw InputError("unknown linear solver '" + name + "' (valid: cholmod, cg, multigrid, auto)");
 }
 
 void validate_solver_settings(const SolverSettings& s, const std::string& where) {

@@ -13,6 +13,7 @@ StaticSolver::StaticSolver(const Problem& problem, LinearSolverKind solver, Newt
       m_reduction(problem.model.stiffness_pattern(), problem.constrained),
       m_controls(controls),
       m_energy(problem.model.stiffness_pattern()) {
+  m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_energy.emplace<ElasticTerm>(problem.model);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.ground != nullptr)

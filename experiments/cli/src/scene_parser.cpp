@@ -190,8 +190,8 @@ SolverSettings parse_solver(const SceneValue& value) {
   }
   if (value.has("load_steps")) solver.load_steps = value.at("load_steps").integer(1);
   if (value.has("linear_solver")) {
-    solver.linear_solver =
-        static_cast<LinearSolverKind>(value.at("linear_solver").choice({"cholmod", "cg"}));
+    solver.linear_solver = static_cast<LinearSolverKind>(
+        value.at("linear_solver").choice({"cholmod", "cg", "multigrid", "auto"}));
   }
   if (value.has("newton_tolerance")) {
     solver.newton_tolerance = value.at("newton_tolerance").positive();

@@ -161,7 +161,10 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                      {"stalled_steps", counters.stalled_steps},
                      {"linear_iterations", counters.linear_iterations},
                      {"reused_factor_solves", counters.reused_factor_solves},
-                     {"max_residual_ratio", counters.max_residual_ratio}};
+                     {"max_residual_ratio", counters.max_residual_ratio},
+                     {"linear_solver", to_string(counters.linear_solver)},
+                     {"multigrid_setups", counters.multigrid_setups},
+                     {"multigrid_setup_seconds", counters.multigrid_setup_seconds}};
   if (counters.stalled_steps > 0)
     stats["newton"]["note"] = std::to_string(counters.stalled_steps) +
                               " Newton solve(s) stopped with the residual stalled at round-off "

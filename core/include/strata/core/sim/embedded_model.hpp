@@ -33,7 +33,8 @@ class EmbeddedElasticModel {
   /// The identity embedding: q = x. `model` must outlive this object.
   explicit EmbeddedElasticModel(const ElasticModel& model);
   /// x = (C ⊗ I₃) q with `vertex_embedding` = C (#V × #Q) and `dof_vertices` (#Q) the mesh vertex
-  /// of each DOF vertex. Throws InputError if C violates the requirements above.
+  /// of each DOF vertex. Throws InputError if C violates the requirements above. C = I with the
+  /// DOF vertices in mesh order (a cut without hanging vertices) takes the identity path.
   EmbeddedElasticModel(const ElasticModel& model, SparseMatrixd vertex_embedding,
                        std::vector<int> dof_vertices);
 

@@ -6,16 +6,28 @@
 ///
 /// Factor reuse (CHOLMOD): successive Newton matrices differ little, so a system is first solved
 /// by conjugate gradients preconditioned with the last Cholesky factor (two triangular solves per
-/// iteration), to a relative residual of 10⁻¹⁰; only when that does not converge within the
-/// iterations one factorisation is worth (its flop count over the flops of one iteration, from
-/// CHOLMOD's analysis, halved; at least 12, at most 60), or meets negative curvature, is A
-/// factorised anew. Deterministic: the budget depends on the pattern only.
+/// iteration), to the relative tolerance (set_relative_tolerance); only when that does not converge
+/// within the iterations one factorisation is worth (its flop count over the flops of one
+/// iteration, from CHOLMOD's analysis, halved; at least 12, at most 60), or meets negative
+/// curvature, is A factorised anew. Deterministic: the budget depends on the pattern only.
+///
+/// Multigrid (multigrid.hpp): CG preconditioned by a V-cycle over nested coarser spaces, to the
+/// relative tolerance. The coarse operators of one setup serve the following solves
+/// (Newton matrices of one step, and of later steps, are close) until a solve needs more than
+/// twice the iterations of the solve right after the setup (plus 4), fails, or meets negative
+/// curvature; then the next solve sets up anew. The finest level's smoother always uses the
+/// current matrix.
 #include <memory>
+#include <vector>
 
 #include "strata/core/common/types.hpp"
+#include "strata/core/sim/multigrid.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 
 namespace strata {
+
+/// Free DOFs from which `automatic` picks multigrid over CHOLMOD (when coarser levels exist).
+inline constexpr Index kMultigridMinDofs = 30000;
 
 class SpdSolver {
  public:
@@ -29,7 +41,28 @@ class SpdSolver {
   /// false if A is not numerically positive definite (CHOLMOD) or CG did not converge.
   bool solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
 
+  /// Resolves `automatic` and `multigrid` for a system with these free DOFs (ascending indices
+  /// into 3 · spaces->num_fine_vertices()) and, when multigrid is chosen, builds its transfers.
+  /// `spaces` may be null or empty (no coarser levels: CHOLMOD). Without this call `automatic`
+  /// and `multigrid` solve with CHOLMOD.
+  void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs);
+
+  /// Relative residual ‖b − A x‖ / ‖b‖ at which the iterative paths (CG on a previous factor,
+  /// multigrid-PCG) stop; default 10⁻¹⁰. Newton sets it per solve (inexact Newton).
+  void set_relative_tolerance(double tolerance) { m_relative_tolerance = tolerance; }
+  double relative_tolerance() const { return m_relative_tolerance; }
+
+  /// The solver in use (never `automatic`).
   LinearSolverKind kind() const { return m_kind; }
+  /// Whether a failed solve proves the matrix indefinite (CHOLMOD), or at least negative
+  /// curvature is detected (multigrid-PCG): Newton may then try the exact Hessian.
+  bool detects_indefinite() const { return m_kind != LinearSolverKind::cg; }
+  /// Multigrid setups (Galerkin products and coarsest factorisation) so far.
+  long multigrid_setups() const { return m_multigrid_setups; }
+  /// Wall time of all multigrid setups so far [s].
+  double multigrid_setup_seconds() const { return m_multigrid_setup_seconds; }
+  /// Levels of the multigrid hierarchy (0 unless multigrid).
+  int multigrid_levels() const;
   long analyses() const { return m_analyses; }              ///< symbolic analyses so far
   long factorizations() const { return m_factorizations; }  ///< numeric factorisations so far
   long cg_iterations() const { return m_cg_iterations; }    ///< CG iterations so far
@@ -39,6 +72,7 @@ class SpdSolver {
  private:
   struct Impl;
   std::unique_ptr<Impl> m_impl;
+  LinearSolverKind m_requested;
   LinearSolverKind m_kind;
   Index m_rows = -1;
   Index m_nonzeros = -1;
@@ -48,7 +82,16 @@ class SpdSolver {
   long m_reused_solves = 0;
   bool m_has_factor = false;
   int m_reuse_budget = 0;  ///< PCG iterations allowed before refactorising
+  double m_relative_tolerance = 1e-10;
+  long m_multigrid_setups = 0;
+  double m_multigrid_setup_seconds = 0.0;
+  bool m_multigrid_stale = true;
+  long m_iterations_after_setup = -1;
+  std::unique_ptr<MultigridPreconditioner> m_multigrid;
   bool solve_with_previous_factor(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
+  bool solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
+  /// PCG with the V-cycle; returns iterations, or −1 (no convergence), −2 (negative curvature).
+  int multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
 };
 
 }  // namespace strata

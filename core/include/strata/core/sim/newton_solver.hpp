@@ -7,8 +7,12 @@
 /// Hessian: the exact Hessian where it is positive definite — tried first, so Newton converges
 /// quadratically near a stable equilibrium — and the PSD-projected one (per element) where the
 /// exact factorisation fails; after a failure the exact Hessian is skipped for 1, 2, 4, …
-/// iterations before it is tried again. Iterative linear solvers (CG) use the projected Hessian
-/// only, since CG cannot detect indefiniteness.
+/// iterations before it is tried again. Plain CG (incomplete Cholesky) uses the projected Hessian
+/// only; multigrid-PCG tries the exact one and refuses it on negative curvature.
+///
+/// Inexact Newton: iterative linear solves stop at a relative residual η_k that follows the
+/// Newton residual (Eisenstat–Walker; at most 10⁻⁴, never tighter than needed to reach the target
+/// in one step); a direct solve is exact anyway.
 ///
 /// Convergence, whichever comes first:
 ///   - residual: ‖g_free‖ ≤ max(tolerance · force_scale, residual_floor);
@@ -45,7 +49,7 @@ struct NewtonSettings {
   double increment_tolerance = 1e-9;
   /// Largest relative increment at which a stalled residual counts as converged.
   double stall_tolerance = 1e-7;
-  /// Try the exact Hessian first (direct solvers only).
+  /// Try the exact Hessian first (solvers that detect indefiniteness).
   bool exact_hessian = true;
   /// Rest positions q_rest (3·#Q) for the displacement scale; empty: the scale is ‖q‖∞.
   const VectorXd* rest_positions = nullptr;

@@ -21,6 +21,7 @@
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/ground_contact.hpp"
+#include "strata/core/sim/multigrid.hpp"
 
 namespace strata {
 
@@ -38,6 +39,9 @@ struct Problem {
   double diagonal = 1.0;                 ///< bounding-box diagonal [m] (FD step scale)
   const GroundPlane* ground = nullptr;   ///< optional rigid ground
   double ground_stiffness = 0.0;         ///< penalty k [N/m] of the static ground term
+  /// Optional coarser spaces below the DOF vertices (the refinement tree's levels) for the
+  /// multigrid linear solver; null: none.
+  const NestedSpaces* nested_spaces = nullptr;
 
   /// s(t) = min(t / T_r, 1).
   double ramp(double t) const;

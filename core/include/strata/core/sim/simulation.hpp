@@ -33,6 +33,7 @@
 #include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/multigrid.hpp"
 #include "strata/core/sim/simulation_run.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 
@@ -65,16 +66,24 @@ struct SimulationOptions {
   /// load factor (first_step + steps taken) / load_steps in static mode, and the Dirichlet ramp
   /// continues from there.
   long first_step = 0;
+  /// Coarser spaces below the DOF vertices for the multigrid linear solver (the refinement tree's
+  /// levels, hierarchy/cut_levels.hpp); empty: none.
+  NestedSpaces nested_spaces;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
 struct SimulationCounters {
-  long steps = 0;                         ///< time or load steps taken
-  long newton_iterations = 0;             ///< over all implicit / static steps
-  long long element_evaluations = 0;      ///< from ElasticModel
-  long factorizations = 0;                ///< numeric factorisations (or CG setups)
-  long linear_iterations = 0;             ///< CG iterations (incl. those on a previous factor)
-  long reused_factor_solves = 0;          ///< linear solves answered without a new factorisation
+  long steps = 0;                        ///< time or load steps taken
+  long newton_iterations = 0;            ///< over all implicit / static steps
+  long long element_evaluations = 0;     ///< from ElasticModel
+  long factorizations = 0;               ///< numeric factorisations (or CG setups)
+  long linear_iterations = 0;            ///< CG iterations (incl. those on a previous factor)
+  long reused_factor_solves = 0;         ///< linear solves answered without a new factorisation
+  long multigrid_setups = 0;             ///< multigrid hierarchies built (multigrid only)
+  double multigrid_setup_seconds = 0.0;  ///< their wall time [s]
+  /// Linear solver of the Newton steps (automatic resolved; over several cuts, that of the
+  /// current one); cholmod for explicit runs.
+  LinearSolverKind linear_solver = LinearSolverKind::cholmod;
   long exact_hessian_iterations = 0;      ///< Newton iterations on the exact Hessian
   long projected_hessian_iterations = 0;  ///< … on the PSD-projected Hessian
   /// Newton solves (time or load steps) that converged on the increment, and that stopped at a
@@ -184,6 +193,7 @@ class Simulation final : public SimulationRun {
   double m_diagonal = 0.0;
   double m_stable_dt = 0.0;
   DivergenceLimits m_limits;
+  NestedSpaces m_nested;
   std::unique_ptr<Problem> m_system;
   const StepperTraits* m_stepper_traits = nullptr;
   std::unique_ptr<TimeStepper> m_stepper;

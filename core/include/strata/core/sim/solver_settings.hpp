@@ -8,8 +8,11 @@ namespace strata {
 /// dynamic: time integration; static_equilibrium: quasi-static load stepping ("static" in scenes).
 enum class SimulationMode { dynamic, static_equilibrium };
 enum class Integrator { symplectic_euler, rk4, implicit_euler };
-/// cholmod: CHOLMOD supernodal Cholesky; cg: conjugate gradients with incomplete Cholesky.
-enum class LinearSolverKind { cholmod, cg };
+/// cholmod: CHOLMOD supernodal Cholesky; cg: conjugate gradients with incomplete Cholesky;
+/// multigrid: conjugate gradients preconditioned by a V-cycle over the refinement tree's levels
+/// (multigrid.hpp; CHOLMOD where the mesh has no coarser levels); automatic: multigrid on meshes
+/// with coarser levels and at least kMultigridMinDofs free DOFs, CHOLMOD otherwise.
+enum class LinearSolverKind { cholmod, cg, multigrid, automatic };
 
 struct SolverSettings {
   SimulationMode mode = SimulationMode::dynamic;
@@ -19,7 +22,7 @@ struct SolverSettings {
   /// Dirichlet ramp time [s] (dynamic): s = min(t / ramp_time, 1); 0 means `duration`.
   double ramp_time = 0.0;
   int load_steps = 10;  ///< N: load factor k/N at step k (static)
-  LinearSolverKind linear_solver = LinearSolverKind::cholmod;
+  LinearSolverKind linear_solver = LinearSolverKind::automatic;
   int max_newton_iterations = 50;
   /// Newton stops when ‖∇E‖ over the free DOFs ≤ tolerance × force scale (static: the applied
   /// external load, or the internal forces of the first guess when there is no load).
@@ -33,7 +36,7 @@ struct SolverSettings {
 
 std::string to_string(SimulationMode mode);    ///< "dynamic" | "static"
 std::string to_string(Integrator integrator);  ///< "symplectic_euler" | "rk4" | "implicit_euler"
-std::string to_string(LinearSolverKind kind);  ///< "cholmod" | "cg"
+std::string to_string(LinearSolverKind kind);  ///< "cholmod" | "cg" | "multigrid" | "auto"
 /// Parsers for scene names; throw InputError listing the valid names.
 SimulationMode simulation_mode_from_string(const std::string& name);
 Integrator integrator_from_string(const std::string& name);

@@ -1,0 +1,284 @@
+#include "strata/core/sim/multigrid.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace strata {
+
+void NestedSpaces::check() const {
+  if (injections.size() != prolongations.size())
+    throw std::invalid_argument("NestedSpaces: one injection per prolongation expected");
+  for (std::size_t k = 0; k < prolongations.size(); ++k) {
+    const SparseMatrixd& P = prolongations[k];
+    if (k + 1 < prolongations.size() && prolongations[k + 1].cols() != P.rows())
+      throw std::invalid_argument("NestedSpaces: sizes of prolongations " + std::to_string(k) +
+                                  " and " + std::to_string(k + 1) + " do not chain");
+    if (static_cast<Index>(injections[k].size()) != P.cols())
+      throw std::invalid_argument("NestedSpaces: injection " + std::to_string(k) +
+                                  " has the wrong size");
+    for (Index j = 0; j < P.cols(); ++j) {
+      const Index i = injections[k][j];
+      if (i < 0 || i >= P.rows() || P.coeff(i, j) != 1.0)
+        throw std::invalid_argument("NestedSpaces: injection " + std::to_string(k) +
+                                    " is not a unit row at coarse vertex " + std::to_string(j));
+    }
+  }
+}
+
+std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
+                                                  const std::vector<Index>& free_dofs) {
+  std::vector<SparseMatrixd> result;
+  if (spaces.empty()) return result;
+  const int levels = spaces.num_levels();
+  // free index of each DOF per level (−1: constrained), finest last.
+  std::vector<std::vector<Index>> free_index(levels);
+  free_index[levels - 1].assign(3 * spaces.num_fine_vertices(), -1);
+  for (std::size_t i = 0; i < free_dofs.size(); ++i)
+    free_index[levels - 1][free_dofs[i]] = static_cast<Index>(i);
+  for (int k = levels - 2; k >= 0; --k) {
+    const std::vector<Index>& injection = spaces.injections[k];
+    std::vector<Index>& index = free_index[k];
+    index.assign(3 * injection.size(), -1);
+    Index next = 0;
+    for (std::size_t j = 0; j < injection.size(); ++j)
+      for (int c = 0; c < 3; ++c)
+        if (free_index[k + 1][3 * injection[j] + c] >= 0) index[3 * j + c] = next++;
+  }
+  for (int k = 0; k + 1 < levels; ++k) {
+    const SparseMatrixd& P = spaces.prolongations[k];
+    const std::vector<Index>& rows = free_index[k + 1];
+    const std::vector<Index>& cols = free_index[k];
+    const Index num_rows = std::count_if(rows.begin(), rows.end(), [](Index i) { return i >= 0; });
+    const Index num_cols = std::count_if(cols.begin(), cols.end(), [](Index i) { return i >= 0; });
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(3 * P.nonZeros());
+    for (Index j = 0; j < P.outerSize(); ++j)
+      for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
+        for (int c = 0; c < 3; ++c) {
+          const Index row = rows[3 * it.row() + c];
+          const Index col = cols[3 * j + c];
+          if (row >= 0 && col >= 0) triplets.emplace_back(row, col, it.value());
+        }
+    SparseMatrixd D(num_rows, num_cols);
+    D.setFromTriplets(triplets.begin(), triplets.end());
+    result.push_back(std::move(D));
+  }
+  return result;
+}
+
+void symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) {
+  const Index n = A.cols();
+  y.resize(n);
+  const auto* outer = A.outerIndexPtr();
+  const auto* inner = A.innerIndexPtr();
+  const double* values = A.valuePtr();
+  const double* xs = x.data();
+  double* ys = y.data();
+  tbb::parallel_for(tbb::blocked_range<Index>(0, n, 4096), [&](const tbb::blocked_range<Index>& r) {
+    for (Index j = r.begin(); j != r.end(); ++j) {
+      double sum = 0.0;
+      for (auto p = outer[j]; p < outer[j + 1]; ++p)
+        sum += values[p] * xs[inner[p]];
+      ys[j] = sum;
+    }
+  });
+}
+
+struct MultigridPreconditioner::Level {
+  SparseMatrixd owned;               ///< coarse Galerkin operator (empty on the finest level)
+  const SparseMatrixd* A = nullptr;  ///< the operator of this level
+  VectorXd inverse_diagonal;
+  double lambda_min = 0.0;  ///< Chebyshev interval of D⁻¹A
+  double lambda_max = 0.0;
+  mutable VectorXd r, d, z, x, b;  ///< scratch of the cycle
+};
+
+struct MultigridPreconditioner::Coarse {
+  Eigen::CholmodSupernodalLLT<SparseMatrixd, Eigen::Lower> llt;
+  bool analysed = false;
+  Index nonzeros = -1;
+};
+
+MultigridPreconditioner::MultigridPreconditioner(std::vector<SparseMatrixd> prolongations,
+                                                 Options options)
+    : m_options(options),
+      m_prolongations(std::move(prolongations)),
+      m_coarse(std::make_unique<Coarse>()) {
+  if (m_options.smoothing_degree < 1)
+    throw std::invalid_argument("MultigridPreconditioner: smoothing_degree must be >= 1");
+  for (std::size_t k = 0; k + 1 < m_prolongations.size(); ++k)
+    if (m_prolongations[k + 1].cols() != m_prolongations[k].rows())
+      throw std::invalid_argument("MultigridPreconditioner: prolongation sizes do not chain");
+  m_levels.resize(m_prolongations.size() + 1);
+  for (auto& level : m_levels)
+    level = std::make_unique<Level>();
+  m_coarse->llt.cholmod().print = 0;
+}
+
+MultigridPreconditioner::~MultigridPreconditioner() = default;
+
+std::vector<Index> MultigridPreconditioner::level_sizes() const {
+  std::vector<Index> sizes;
+  for (const auto& level : m_levels)
+    sizes.push_back(level->A != nullptr ? level->A->rows() : 0);
+  return sizes;
+}
+
+bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
+  const auto start = std::chrono::steady_clock::now();
+  const int L = num_levels() - 1;
+  if (!m_prolongations.empty() && m_prolongations.back().rows() != A.rows())
+    throw std::invalid_argument("MultigridPreconditioner::setup: matrix has " +
+                                std::to_string(A.rows()) + " rows, the finest level " +
+                                std::to_string(m_prolongations.back().rows()));
+  m_levels[L]->A = &A;
+  m_levels[L]->owned.resize(0, 0);
+  for (int k = L - 1; k >= 0; --k) {
+    const SparseMatrixd& P = m_prolongations[k];
+    const SparseMatrixd AP = *m_levels[k + 1]->A * P;
+    const SparseMatrixd Pt = P.transpose();
+    m_levels[k]->owned = Pt * AP;
+    m_levels[k]->owned.makeCompressed();
+    m_levels[k]->A = &m_levels[k]->owned;
+  }
+  for (int k = 1; k <= L; ++k)
+    setup_smoother(*m_levels[k]);
+  const SparseMatrixd& A0 = *m_levels[0]->A;
+  if (!m_coarse->analysed || m_coarse->nonzeros != A0.nonZeros()) {
+    m_coarse->llt.analyzePattern(A0);
+    m_coarse->analysed = true;
+    m_coarse->nonzeros = A0.nonZeros();
+  }
+  m_coarse->llt.factorize(A0);
+  m_setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return m_coarse->llt.info() == Eigen::Success;
+}
+
+void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {
+  Level& finest = *m_levels.back();
+  if (finest.A == nullptr || finest.A->rows() != A.rows())
+    throw std::logic_error("MultigridPreconditioner::update_finest before setup or size change");
+  finest.A = &A;
+  if (num_levels() == 1) return;
+  // The new diagonal; the eigenvalue estimate of the setup stays (nearby matrices; a smoother
+  // that no longer fits shows as a failed or non-positive PCG solve, and the caller sets up anew).
+  for (Index i = 0; i < A.rows(); ++i) {
+    const double d = A.coeff(i, i);
+    finest.inverse_diagonal[i] = d > 0.0 ? 1.0 / d : 0.0;
+  }
+}
+
+void MultigridPreconditioner::setup_smoother(Level& level) {
+  const SparseMatrixd& A = *level.A;
+  const Index n = A.rows();
+  level.inverse_diagonal.resize(n);
+  for (Index i = 0; i < n; ++i) {
+    const double d = A.coeff(i, i);
+    level.inverse_diagonal[i] = d > 0.0 ? 1.0 / d : 0.0;
+  }
+  // Largest eigenvalue of D⁻¹A by Lanczos through Jacobi-preconditioned CG (faster to converge
+  // at the spectrum's ends than power iteration), from a fixed pseudo-random right-hand side.
+  std::mt19937 random(12345u);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  VectorXd r(n);
+  for (Index i = 0; i < n; ++i)
+    r[i] = uniform(random);
+  VectorXd z = level.inverse_diagonal.cwiseProduct(r);
+  VectorXd p = z, Ap(n);
+  double rz = r.dot(z);
+  std::vector<double> alphas, betas;
+  for (int it = 0; it < m_options.lanczos_iterations && rz > 0.0; ++it) {
+    symmetric_product(A, p, Ap);
+    const double curvature = p.dot(Ap);
+    if (!(curvature > 0.0)) break;
+    const double alpha = rz / curvature;
+    r -= alpha * Ap;
+    z = level.inverse_diagonal.cwiseProduct(r);
+    const double rz_next = r.dot(z);
+    const double beta = rz_next / rz;
+    alphas.push_back(alpha);
+    betas.push_back(beta);
+    p = z + beta * p;
+    rz = rz_next;
+  }
+  double lambda = 1.0;
+  const int m = static_cast<int>(alphas.size());
+  if (m > 0) {
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(m, m);
+    for (int j = 0; j < m; ++j) {
+      T(j, j) = 1.0 / alphas[j] + (j > 0 ? betas[j - 1] / alphas[j - 1] : 0.0);
+      if (j + 1 < m) T(j, j + 1) = T(j + 1, j) = std::sqrt(betas[j]) / alphas[j];
+    }
+    lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly)
+                 .eigenvalues()
+                 .maxCoeff();
+  }
+  level.lambda_max = 1.1 * lambda;
+  level.lambda_min = m_options.chebyshev_lower * lambda;
+}
+
+void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, VectorXd& x,
+                                     bool zero_start) const {
+  // Chebyshev iteration for A x = b preconditioned by D, started from x (Saad, Iterative
+  // Methods for Sparse Linear Systems, Alg. 12.1).
+  const SparseMatrixd& A = *level.A;
+  const double theta = 0.5 * (level.lambda_max + level.lambda_min);
+  const double delta = 0.5 * (level.lambda_max - level.lambda_min);
+  const double sigma = theta / delta;
+  VectorXd& r = level.r;
+  VectorXd& d = level.d;
+  VectorXd& Ad = level.z;
+  if (zero_start) {
+    r = b;
+  } else {
+    symmetric_product(A, x, r);
+    r = b - r;
+  }
+  d = level.inverse_diagonal.cwiseProduct(r) / theta;
+  double rho = 1.0 / sigma;
+  for (int i = 0; i < m_options.smoothing_degree; ++i) {
+    x += d;
+    if (i + 1 == m_options.smoothing_degree) break;
+    symmetric_product(A, d, Ad);
+    r -= Ad;
+    const double rho_next = 1.0 / (2.0 * sigma - rho);
+    d = (rho_next * rho) * d + (2.0 * rho_next / delta) * level.inverse_diagonal.cwiseProduct(r);
+    rho = rho_next;
+  }
+}
+
+void MultigridPreconditioner::cycle(int k, const VectorXd& b, VectorXd& x) const {
+  if (k == 0) {
+    x = m_coarse->llt.solve(b);
+    return;
+  }
+  const Level& level = *m_levels[k];
+  const Level& coarse = *m_levels[k - 1];
+  const SparseMatrixd& P = m_prolongations[k - 1];
+  x.setZero(b.size());
+  smooth(level, b, x, true);
+  symmetric_product(*level.A, x, level.r);
+  level.r = b - level.r;
+  coarse.b.noalias() = P.transpose() * level.r;
+  cycle(k - 1, coarse.b, coarse.x);
+  x.noalias() += P * coarse.x;
+  smooth(level, b, x, false);
+}
+
+void MultigridPreconditioner::apply(ConstRef<VectorXd> r, VectorXd& z) const {
+  const Level& finest = *m_levels.back();
+  if (finest.A == nullptr) throw std::logic_error("MultigridPreconditioner::apply before setup");
+  finest.b = r;
+  cycle(num_levels() - 1, finest.b, z);
+}
+
+}  // namespace strata
