@@ -1,6 +1,7 @@
 #include "strata/core/sim/multigrid.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <Eigen/CholmodSupport>
@@ -93,6 +94,76 @@ void symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y
   });
 }
 
+SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
+  const Index m = P.cols();
+  const SparseMatrixd PT = P.transpose();  // column i of PT = row i of P
+  // Column blocks computed in parallel, each into its own compressed fragment.
+  constexpr Index kBlock = 512;
+  const Index num_blocks = (m + kBlock - 1) / kBlock;
+  struct Fragment {
+    std::vector<int> counts;
+    std::vector<int> rows;
+    std::vector<double> values;
+  };
+  std::vector<Fragment> fragments(num_blocks);
+  struct Accumulator {
+    std::vector<double> value;
+    std::vector<Index> mark;
+    std::vector<int> touched;
+  };
+  tbb::enumerable_thread_specific<Accumulator> accumulators;
+  tbb::parallel_for(Index(0), num_blocks, [&](Index block) {
+    Accumulator& acc = accumulators.local();
+    if (static_cast<Index>(acc.value.size()) != m) {
+      acc.value.assign(m, 0.0);
+      acc.mark.assign(m, -1);
+    }
+    Fragment& fragment = fragments[block];
+    const Index first = block * kBlock;
+    const Index last = std::min(m, first + kBlock);
+    for (Index J = first; J < last; ++J) {
+      acc.touched.clear();
+      for (SparseMatrixd::InnerIterator p(P, J); p; ++p)
+        for (SparseMatrixd::InnerIterator a(A, p.row()); a; ++a) {
+          const double ap = a.value() * p.value();
+          for (SparseMatrixd::InnerIterator q(PT, a.row()); q; ++q) {
+            const Index L = q.row();
+            if (acc.mark[L] != J) {
+              acc.mark[L] = J;
+              acc.value[L] = 0.0;
+              acc.touched.push_back(static_cast<int>(L));
+            }
+            acc.value[L] += q.value() * ap;
+          }
+        }
+      std::sort(acc.touched.begin(), acc.touched.end());
+      fragment.counts.push_back(static_cast<int>(acc.touched.size()));
+      for (const int L : acc.touched) {
+        fragment.rows.push_back(L);
+        fragment.values.push_back(acc.value[L]);
+      }
+    }
+  });
+  Index nonzeros = 0;
+  for (const Fragment& fragment : fragments)
+    nonzeros += static_cast<Index>(fragment.rows.size());
+  SparseMatrixd C(m, m);
+  C.resizeNonZeros(nonzeros);
+  auto* outer = C.outerIndexPtr();
+  outer[0] = 0;
+  Index column = 0, offset = 0;
+  for (const Fragment& fragment : fragments) {
+    for (const int count : fragment.counts) {
+      outer[column + 1] = static_cast<int>(outer[column] + count);
+      ++column;
+    }
+    std::copy(fragment.rows.begin(), fragment.rows.end(), C.innerIndexPtr() + offset);
+    std::copy(fragment.values.begin(), fragment.values.end(), C.valuePtr() + offset);
+    offset += static_cast<Index>(fragment.rows.size());
+  }
+  return C;
+}
+
 struct MultigridPreconditioner::Level {
   SparseMatrixd owned;               ///< coarse Galerkin operator (empty on the finest level)
   const SparseMatrixd* A = nullptr;  ///< the operator of this level
@@ -143,11 +214,7 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   m_levels[L]->A = &A;
   m_levels[L]->owned.resize(0, 0);
   for (int k = L - 1; k >= 0; --k) {
-    const SparseMatrixd& P = m_prolongations[k];
-    const SparseMatrixd AP = *m_levels[k + 1]->A * P;
-    const SparseMatrixd Pt = P.transpose();
-    m_levels[k]->owned = Pt * AP;
-    m_levels[k]->owned.makeCompressed();
+    m_levels[k]->owned = galerkin_product(*m_levels[k + 1]->A, m_prolongations[k]);
     m_levels[k]->A = &m_levels[k]->owned;
   }
   for (int k = 1; k <= L; ++k)

@@ -59,6 +59,10 @@ struct MultigridOptions {
   double chebyshev_lower = 0.05;
 };
 
+/// PᵀAP for a symmetric A (both triangles, column-major), computed column by column in parallel
+/// (no intermediate A P); the result has both triangles, rows sorted in each column.
+SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
+
 class MultigridPreconditioner {
  public:
   using Options = MultigridOptions;
