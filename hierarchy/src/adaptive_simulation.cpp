@@ -70,6 +70,7 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.reused_factor_solves += b.reused_factor_solves;
   a.multigrid_setups += b.multigrid_setups;
   a.multigrid_setup_seconds += b.multigrid_setup_seconds;
+  a.multigrid_direct_fallbacks += b.multigrid_direct_fallbacks;
   a.linear_solver = b.linear_solver;
   a.exact_hessian_iterations += b.exact_hessian_iterations;
   a.projected_hessian_iterations += b.projected_hessian_iterations;

@@ -137,6 +137,31 @@ TEST(CutMultigrid, ReachesTheDirectSolution) {
   }
 }
 
+// A system multigrid-PCG does not solve within its iteration limit is solved by CHOLMOD.
+TEST(CutMultigrid, FallsBackToCholmod) {
+  TetTree tree(beam(), 2);
+  const ConstrainedCut c = flatten_cut(ActiveCut::uniform(tree, 2));
+  const ElasticModel model(c.flat.mesh.vertices, c.flat.mesh.tets, material(0.3));
+  SparseMatrixd K;
+  model.stiffness(model.rest_positions(), K, false);
+  std::vector<char> constrained(model.num_dofs(), 0);
+  for (Index v = 0; v < model.num_vertices(); ++v)
+    if (c.flat.mesh.vertices(v, 0) == 0.0)
+      constrained[3 * v] = constrained[3 * v + 1] = constrained[3 * v + 2] = 1;
+  const DofReduction reduction(model.stiffness_pattern(), constrained);
+  SparseMatrixd A;
+  reduction.restrict_matrix(K, A);
+  const VectorXd b = VectorXd::LinSpaced(A.rows(), -1.0, 1.0);
+  const NestedSpaces spaces = cut_nested_spaces(tree, c);
+  SpdSolver solver(LinearSolverKind::multigrid);
+  solver.use_nested_spaces(&spaces, reduction.free_dofs());
+  solver.set_max_iterations(2);
+  VectorXd x;
+  ASSERT_TRUE(solver.solve(A, b, x));
+  EXPECT_EQ(solver.direct_fallbacks(), 1);
+  EXPECT_LE((A * x - b).norm(), 1e-10 * b.norm());
+}
+
 // Deterministic PCG iteration counts (relative residual 10⁻¹⁰) of uniform cuts at levels 1–3:
 // measured 16, 21, 24 at ν = 0.3 and 41, 53, 62 at ν = 0.49. Bound: each level at most 1.35×
 // the previous one plus one, and at most 30 / 75 iterations.

@@ -53,31 +53,7 @@ bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x)
     return true;
   }
   if (m_kind == LinearSolverKind::multigrid) return solve_multigrid(A, b, x);
-  if (m_kind == LinearSolverKind::cholmod) {
-    if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) {
-      m_impl->cholmod.analyzePattern(A);
-      m_rows = A.rows();
-      m_nonzeros = A.nonZeros();
-      ++m_analyses;
-      m_has_factor = false;
-      // One factorisation costs `fl` flops, one PCG iteration about 4·nnz(L) + 4·nnz(A).
-      const double factor_flops = m_impl->cholmod.cholmod().fl;
-      const double iteration_flops =
-          4.0 * m_impl->cholmod.cholmod().lnz + 4.0 * static_cast<double>(A.nonZeros());
-      const double worth = iteration_flops > 0.0 ? 0.5 * factor_flops / iteration_flops : 0.0;
-      m_reuse_budget = static_cast<int>(std::clamp(worth, 12.0, 60.0));
-    }
-    if (m_has_factor && solve_with_previous_factor(A, b, x)) {
-      ++m_reused_solves;
-      return true;
-    }
-    m_impl->cholmod.factorize(A);
-    ++m_factorizations;
-    m_has_factor = m_impl->cholmod.info() == Eigen::Success;
-    if (!m_has_factor) return false;
-    x = m_impl->cholmod.solve(b);
-    return m_impl->cholmod.info() == Eigen::Success && x.allFinite();
-  }
+  if (m_kind == LinearSolverKind::cholmod) return solve_cholmod(A, b, x);
   m_impl->cg.setMaxIterations(std::max<Index>(1000, 10 * A.rows()));
   m_impl->cg.compute(A);
   ++m_factorizations;
@@ -85,6 +61,32 @@ bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x)
   x = m_impl->cg.solve(b);
   m_cg_iterations += m_impl->cg.iterations();
   return m_impl->cg.info() == Eigen::Success && x.allFinite();
+}
+
+bool SpdSolver::solve_cholmod(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
+  if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) {
+    m_impl->cholmod.analyzePattern(A);
+    m_rows = A.rows();
+    m_nonzeros = A.nonZeros();
+    ++m_analyses;
+    m_has_factor = false;
+    // One factorisation costs `fl` flops, one PCG iteration about 4·nnz(L) + 4·nnz(A).
+    const double factor_flops = m_impl->cholmod.cholmod().fl;
+    const double iteration_flops =
+        4.0 * m_impl->cholmod.cholmod().lnz + 4.0 * static_cast<double>(A.nonZeros());
+    const double worth = iteration_flops > 0.0 ? 0.5 * factor_flops / iteration_flops : 0.0;
+    m_reuse_budget = static_cast<int>(std::clamp(worth, 12.0, 60.0));
+  }
+  if (m_has_factor && solve_with_previous_factor(A, b, x)) {
+    ++m_reused_solves;
+    return true;
+  }
+  m_impl->cholmod.factorize(A);
+  ++m_factorizations;
+  m_has_factor = m_impl->cholmod.info() == Eigen::Success;
+  if (!m_has_factor) return false;
+  x = m_impl->cholmod.solve(b);
+  return m_impl->cholmod.info() == Eigen::Success && x.allFinite();
 }
 
 bool SpdSolver::solve_with_previous_factor(const SparseMatrixd& A, ConstRef<VectorXd> b,
@@ -120,9 +122,9 @@ bool SpdSolver::solve_with_previous_factor(const SparseMatrixd& A, ConstRef<Vect
 }
 
 bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
-  if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) {
-    m_rows = A.rows();
-    m_nonzeros = A.nonZeros();
+  if (A.rows() != m_multigrid_rows || A.nonZeros() != m_multigrid_nonzeros) {
+    m_multigrid_rows = A.rows();
+    m_multigrid_nonzeros = A.nonZeros();
     m_multigrid_stale = true;
   }
   bool fresh = false;
@@ -152,7 +154,14 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
     m_iterations_after_setup = -1;
     iterations = multigrid_pcg(A, b, x);
   }
-  if (iterations < 0) {
+  if (iterations == -1) {
+    // Not converged on a fresh hierarchy (a hard system: thin, nearly incompressible): this
+    // solve is direct.
+    m_multigrid_stale = true;
+    ++m_direct_fallbacks;
+    return solve_cholmod(A, b, x);
+  }
+  if (iterations < 0) {  // negative curvature: A is not positive definite
     m_multigrid_stale = true;
     return false;
   }
@@ -164,7 +173,6 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
 }
 
 int SpdSolver::multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
-  constexpr int kMaxIterations = 500;
   const double b_norm = b.norm();
   x.setZero(b.size());
   if (b_norm == 0.0) return 0;
@@ -174,7 +182,7 @@ int SpdSolver::multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, Vecto
   m_multigrid->apply(r, z);
   VectorXd p = z;
   double rz = r.dot(z);
-  for (int k = 0; k < kMaxIterations; ++k) {
+  for (int k = 0; k < m_max_iterations; ++k) {
     symmetric_product(A, p, Ap);
     const double curvature = p.dot(Ap);
     if (!(rz > 0.0)) return -1;  // the preconditioner, not A, is not positive definite

@@ -279,6 +279,7 @@ SimulationCounters Simulation::counters() const {
     counters.reused_factor_solves = solver->reused_factor_solves();
     counters.multigrid_setups = solver->multigrid_setups();
     counters.multigrid_setup_seconds = solver->multigrid_setup_seconds();
+    counters.multigrid_direct_fallbacks = solver->direct_fallbacks();
     counters.linear_solver = solver->kind();
   }
   return counters;

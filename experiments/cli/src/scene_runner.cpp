@@ -164,7 +164,8 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                      {"max_residual_ratio", counters.max_residual_ratio},
                      {"linear_solver", to_string(counters.linear_solver)},
                      {"multigrid_setups", counters.multigrid_setups},
-                     {"multigrid_setup_seconds", counters.multigrid_setup_seconds}};
+                     {"multigrid_setup_seconds", counters.multigrid_setup_seconds},
+                     {"multigrid_direct_fallbacks", counters.multigrid_direct_fallbacks}};
   if (counters.stalled_steps > 0)
     stats["newton"]["note"] = std::to_string(counters.stalled_steps) +
                               " Newton solve(s) stopped with the residual stalled at round-off "

@@ -16,7 +16,8 @@
 /// (Newton matrices of one step, and of later steps, are close) until a solve needs more than
 /// twice the iterations of the solve right after the setup (plus 4), fails, or meets negative
 /// curvature; then the next solve sets up anew. The finest level's smoother always uses the
-/// current matrix.
+/// current matrix. A system multigrid-PCG does not solve within 500 iterations on a fresh
+/// hierarchy is solved by CHOLMOD (counted, direct_fallbacks).
 #include <memory>
 #include <vector>
 
@@ -27,7 +28,7 @@
 namespace strata {
 
 /// Free DOFs from which `automatic` picks multigrid over CHOLMOD (when coarser levels exist).
-inline constexpr Index kMultigridMinDofs = 30000;
+inline constexpr Index kMultigridMinDofs = 8000;
 
 class SpdSolver {
  public:
@@ -51,6 +52,8 @@ class SpdSolver {
   /// multigrid-PCG) stop; default 10⁻¹⁰. Newton sets it per solve (inexact Newton).
   void set_relative_tolerance(double tolerance) { m_relative_tolerance = tolerance; }
   double relative_tolerance() const { return m_relative_tolerance; }
+  /// Iteration limit of multigrid-PCG (default 500) before it falls back to CHOLMOD.
+  void set_max_iterations(int iterations) { m_max_iterations = iterations; }
 
   /// The solver in use (never `automatic`).
   LinearSolverKind kind() const { return m_kind; }
@@ -59,6 +62,8 @@ class SpdSolver {
   bool detects_indefinite() const { return m_kind != LinearSolverKind::cg; }
   /// Multigrid setups (Galerkin products and coarsest factorisation) so far.
   long multigrid_setups() const { return m_multigrid_setups; }
+  /// Multigrid solves that did not converge on a fresh hierarchy and were solved by CHOLMOD.
+  long direct_fallbacks() const { return m_direct_fallbacks; }
   /// Wall time of all multigrid setups so far [s].
   double multigrid_setup_seconds() const { return m_multigrid_setup_seconds; }
   /// Levels of the multigrid hierarchy (0 unless multigrid).
@@ -83,12 +88,17 @@ class SpdSolver {
   bool m_has_factor = false;
   int m_reuse_budget = 0;  ///< PCG iterations allowed before refactorising
   double m_relative_tolerance = 1e-10;
+  int m_max_iterations = 500;
+  Index m_multigrid_rows = -1;
+  Index m_multigrid_nonzeros = -1;
+  long m_direct_fallbacks = 0;
   long m_multigrid_setups = 0;
   double m_multigrid_setup_seconds = 0.0;
   bool m_multigrid_stale = true;
   long m_iterations_after_setup = -1;
   std::unique_ptr<MultigridPreconditioner> m_multigrid;
   bool solve_with_previous_factor(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
+  bool solve_cholmod(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   bool solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   /// PCG with the V-cycle; returns iterations, or −1 (no convergence), −2 (negative curvature).
   int multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);

@@ -81,6 +81,7 @@ struct SimulationCounters {
   long reused_factor_solves = 0;         ///< linear solves answered without a new factorisation
   long multigrid_setups = 0;             ///< multigrid hierarchies built (multigrid only)
   double multigrid_setup_seconds = 0.0;  ///< their wall time [s]
+  long multigrid_direct_fallbacks = 0;   ///< multigrid solves finished by CHOLMOD
   /// Linear solver of the Newton steps (automatic resolved; over several cuts, that of the
   /// current one); cholmod for explicit runs.
   LinearSolverKind linear_solver = LinearSolverKind::cholmod;
