@@ -183,6 +183,7 @@ void AdaptiveSimulation::initial_adaptation() {
     options.dof_vertices = constraints.free_vertices();
     options.extra_mesh_forces =
         m_mesh_external - gravity_forces(m_simulation->vertex_mass(), m_gravity);
+    options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
     std::unique_ptr<Simulation> solve;
     try {
       solve = std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet,

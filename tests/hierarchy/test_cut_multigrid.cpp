@@ -77,6 +77,8 @@ SolveResult solve_both(const ActiveCut& cut, double poisson_ratio) {
   multigrid.use_nested_spaces(&spaces, reduction.free_dofs());
   EXPECT_EQ(multigrid.kind(), LinearSolverKind::multigrid);
   EXPECT_TRUE(multigrid.solve(A, b, result.multigrid));
+  EXPECT_EQ(multigrid.direct_fallbacks(), 0);  // solved by multigrid, not by CHOLMOD
+  EXPECT_EQ(multigrid.kind(), LinearSolverKind::multigrid);
   result.iterations = multigrid.cg_iterations();
   result.levels = multigrid.multigrid_levels();
   return result;
@@ -160,10 +162,59 @@ TEST(CutMultigrid, FallsBackToCholmod) {
   ASSERT_TRUE(solver.solve(A, b, x));
   EXPECT_EQ(solver.direct_fallbacks(), 1);
   EXPECT_LE((A * x - b).norm(), 1e-10 * b.norm());
+  EXPECT_EQ(solver.kind(), LinearSolverKind::cholmod);  // A factorised: CHOLMOD from now on
+  EXPECT_TRUE(solver.solve(A, b, x));
+  EXPECT_EQ(solver.direct_fallbacks(), 1);
+}
+
+// An indefinite matrix (negative curvature) is refused, and multigrid stays for the next one; a
+// nearby matrix reuses the hierarchy (no new setup); the solutions are the direct ones.
+TEST(CutMultigrid, RefusesIndefiniteAndReusesTheHierarchy) {
+  TetTree tree(beam(), 2);
+  const ConstrainedCut c = flatten_cut(ActiveCut::uniform(tree, 2));
+  const ElasticModel model(c.flat.mesh.vertices, c.flat.mesh.tets, material(0.3));
+  SparseMatrixd K;
+  model.stiffness(model.rest_positions(), K, false);
+  std::vector<char> constrained(model.num_dofs(), 0);
+  for (Index v = 0; v < model.num_vertices(); ++v)
+    if (c.flat.mesh.vertices(v, 0) == 0.0)
+      constrained[3 * v] = constrained[3 * v + 1] = constrained[3 * v + 2] = 1;
+  const DofReduction reduction(model.stiffness_pattern(), constrained);
+  SparseMatrixd A;
+  reduction.restrict_matrix(K, A);
+  const VectorXd b = VectorXd::LinSpaced(A.rows(), -1.0, 1.0);
+  const NestedSpaces spaces = cut_nested_spaces(tree, c);
+  SpdSolver solver(LinearSolverKind::multigrid);
+  solver.use_nested_spaces(&spaces, reduction.free_dofs());
+  VectorXd x;
+  ASSERT_TRUE(solver.solve(A, b, x));
+  EXPECT_EQ(solver.multigrid_setups(), 1);
+
+  // 1 % stiffer: the same hierarchy serves.
+  const SparseMatrixd A2 = 1.01 * A;
+  ASSERT_TRUE(solver.solve(A2, b, x));
+  EXPECT_EQ(solver.multigrid_setups(), 1);
+  SpdSolver direct(LinearSolverKind::cholmod);
+  VectorXd expected;
+  ASSERT_TRUE(direct.solve(A2, b, expected));
+  EXPECT_LE((x - expected).norm(), 1e-8 * expected.norm());
+
+  // Indefinite: shift the spectrum below zero in part.
+  double diagonal = 0.0;
+  for (Index i = 0; i < A.rows(); ++i)
+    diagonal = std::max(diagonal, A.coeff(i, i));
+  SparseMatrixd I(A.rows(), A.rows());
+  I.setIdentity();
+  const SparseMatrixd indefinite = A - 0.3 * diagonal * I;
+  EXPECT_FALSE(solver.solve(indefinite, b, x));
+  EXPECT_EQ(solver.kind(), LinearSolverKind::multigrid);
+  ASSERT_TRUE(solver.solve(A, b, x));
+  ASSERT_TRUE(direct.solve(A, b, expected));
+  EXPECT_LE((x - expected).norm(), 1e-8 * expected.norm());
 }
 
 // Deterministic PCG iteration counts (relative residual 10⁻¹⁰) of uniform cuts at levels 1–3:
-// measured 16, 21, 24 at ν = 0.3 and 41, 53, 62 at ν = 0.49. Bound: each level at most 1.35×
+// measured 17, 21, 24 at ν = 0.3 and 42, 54, 63 at ν = 0.49. Bound: each level at most 1.35×
 // the previous one plus one, and at most 30 / 75 iterations.
 TEST(CutMultigrid, IterationsStayBoundedUnderRefinement) {
   for (const double nu : {0.3, 0.49}) {
@@ -210,6 +261,7 @@ TEST(CutMultigrid, RunsMatchCholmod) {
         while (!sim.finished())
           sim.advance();
         EXPECT_EQ(sim.counters().linear_solver, kind);
+        EXPECT_EQ(sim.counters().multigrid_direct_fallbacks, 0);
         return VectorXd(sim.simulation().positions() - flatten(sim.simulation().mesh().vertices));
       };
       const VectorXd direct = run(LinearSolverKind::cholmod);

@@ -1,6 +1,8 @@
 #include "strata/core/fem/elastic_model.hpp"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
@@ -83,6 +85,7 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
   m_sorted_tets.resize(4 * num_tets);
   m_sorted_Dm_inv.resize(9 * num_tets);
   m_sorted_volume.resize(num_tets);
+  m_sorted_Dm_inv_det.resize(num_tets);
   for (Index i = 0; i < num_tets; ++i) {
     const int t = m_partition.order[i];
     for (int k = 0; k < 4; ++k)
@@ -90,6 +93,7 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
     Eigen::Map<Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
     Dm_inv = m_rest.Dm_inv[t];
     m_sorted_volume[i] = m_rest.rest_volume[t];
+    m_sorted_Dm_inv_det[i] = m_rest.Dm_inv[t].determinant();
   }
   // Rest data regrouped for the vectorised kernels, one contiguous block per lane group g: entry
   // (j, c) of Dm⁻¹ of its kLanes tets at [g · kLaneRest + (3c + j) · kLanes + lane], then the rest
@@ -407,18 +411,38 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
 
 std::pair<double, Index> ElasticModel::min_volume_ratio(ConstRef<VectorXd> x) const {
   check_size(x, num_dofs());
-  double min_J = std::numeric_limits<double>::infinity();
-  Index min_tet = -1;
-  for (Index t = 0; t < num_tets(); ++t) {
-    int tet[4] = {m_tets(t, 0), m_tets(t, 1), m_tets(t, 2), m_tets(t, 3)};
-    const double J = (edge_matrix_at(x.data(), tet) * m_rest.Dm_inv[t]).determinant();
-    if (J < min_J || std::isnan(J)) {
-      min_J = J;
-      min_tet = t;
-      if (std::isnan(J)) break;
+  // J = det(Ds Dm⁻¹) = det(Ds) det(Dm⁻¹), over the sorted tets in parallel. The smallest J wins,
+  // a NaN before any number, ties to the smaller tet index: the same answer on any schedule.
+  struct Smallest {
+    double J = std::numeric_limits<double>::infinity();
+    Index tet = -1;
+    bool before(const Smallest& other) const {
+      if (tet < 0) return false;
+      if (other.tet < 0) return true;
+      const bool nan = std::isnan(J), other_nan = std::isnan(other.J);
+      if (nan != other_nan) return nan;
+      if (!nan && J != other.J) return J < other.J;
+      return tet < other.tet;
     }
-  }
-  return {min_J, min_tet};
+  };
+  const double* p = x.data();
+  const Smallest smallest = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, num_tets(), 8192), Smallest{},
+      [&](const tbb::blocked_range<Index>& range, Smallest best) {
+        for (Index i = range.begin(); i != range.end(); ++i) {
+          const int* tet = &m_sorted_tets[4 * i];
+          const Vector3d x0(p[3 * tet[0]], p[3 * tet[0] + 1], p[3 * tet[0] + 2]);
+          const Vector3d e1 = Vector3d(p[3 * tet[1]], p[3 * tet[1] + 1], p[3 * tet[1] + 2]) - x0;
+          const Vector3d e2 = Vector3d(p[3 * tet[2]], p[3 * tet[2] + 1], p[3 * tet[2] + 2]) - x0;
+          const Vector3d e3 = Vector3d(p[3 * tet[3]], p[3 * tet[3] + 1], p[3 * tet[3] + 2]) - x0;
+          const Smallest here{e1.dot(e2.cross(e3)) * m_sorted_Dm_inv_det[i],
+                              static_cast<Index>(m_partition.order[i])};
+          if (here.before(best)) best = here;
+        }
+        return best;
+      },
+      [](const Smallest& a, const Smallest& b) { return a.before(b) ? a : b; });
+  return {smallest.J, smallest.tet};
 }
 
 TetFields ElasticModel::tet_fields(ConstRef<VectorXd> x) const {

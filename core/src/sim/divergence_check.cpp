@@ -1,5 +1,9 @@
 #include "strata/core/sim/divergence_check.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
 #include <string>
 
 #include "strata/core/common/error.hpp"
@@ -21,16 +25,33 @@ void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<
       context + ": step " + std::to_string(step) + ", t = " + std::to_string(time) + ": ";
   auto fail = [&](const std::string& what) { throw DivergenceError(where + what, step, time); };
   const VectorXd& rest = model.rest_positions();
-  for (Index i = 0; i < x.size() / 3; ++i) {
-    if (!x.segment<3>(3 * i).allFinite() || (v.size() > 0 && !v.segment<3>(3 * i).allFinite()))
+  const Index num_vertices = x.size() / 3;
+  const bool has_v = v.size() > 0;
+  auto vertex_fails = [&](Index i) {
+    if (!x.segment<3>(3 * i).allFinite() || (has_v && !v.segment<3>(3 * i).allFinite()))
+      return true;
+    if (has_v && v.segment<3>(3 * i).norm() > limits.max_speed) return true;
+    return (x.segment<3>(3 * i) - rest.segment<3>(3 * i)).norm() > limits.max_displacement;
+  };
+  // The first failing vertex (smallest index, on any schedule), then its message.
+  const Index first = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, num_vertices, 8192), num_vertices,
+      [&](const tbb::blocked_range<Index>& range, Index found) {
+        for (Index i = range.begin(); i != range.end() && i < found; ++i)
+          if (vertex_fails(i)) return i;
+        return found;
+      },
+      [](Index a, Index b) { return std::min(a, b); });
+  if (first < num_vertices) {
+    const Index i = first;
+    if (!x.segment<3>(3 * i).allFinite() || (has_v && !v.segment<3>(3 * i).allFinite()))
       fail("non-finite position or velocity at vertex " + std::to_string(i));
-    if (v.size() > 0 && v.segment<3>(3 * i).norm() > limits.max_speed)
+    if (has_v && v.segment<3>(3 * i).norm() > limits.max_speed)
       fail("vertex " + std::to_string(i) + " moves at " +
            std::to_string(v.segment<3>(3 * i).norm()) + " m/s, above the blow-up limit " +
            std::to_string(limits.max_speed) + " m/s (10 x P-wave speed); reduce dt");
-    if ((x.segment<3>(3 * i) - rest.segment<3>(3 * i)).norm() > limits.max_displacement)
-      fail("vertex " + std::to_string(i) + " displaced beyond the blow-up limit " +
-           std::to_string(limits.max_displacement) + " m (100 x bounding-box diagonal)");
+    fail("vertex " + std::to_string(i) + " displaced beyond the blow-up limit " +
+         std::to_string(limits.max_displacement) + " m (100 x bounding-box diagonal)");
   }
   if (limits.check_inversion) {
     const auto [min_j, tet] = model.min_volume_ratio(x);

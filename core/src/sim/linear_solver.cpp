@@ -3,6 +3,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
+#include <cmath>
 
 namespace strata {
 
@@ -27,6 +28,8 @@ SpdSolver::~SpdSolver() = default;
 
 void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs) {
   const LinearSolverKind requested = m_requested;
+  m_rows = m_nonzeros = m_multigrid_rows = m_multigrid_nonzeros = -1;
+  m_has_factor = false;
   m_multigrid.reset();
   m_multigrid_stale = true;
   const bool has_levels = spaces != nullptr && !spaces->empty();
@@ -127,15 +130,29 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
     m_multigrid_nonzeros = A.nonZeros();
     m_multigrid_stale = true;
   }
-  bool fresh = false;
-  if (m_multigrid_stale) {
+  auto setup = [&] {
     ++m_multigrid_setups;
     ++m_factorizations;
     const bool ok = m_multigrid->setup(A);
     m_multigrid_setup_seconds += m_multigrid->setup_seconds();
-    if (!ok) return false;  // the coarsest Galerkin operator is not positive definite
-    m_multigrid_stale = false;
-    m_iterations_after_setup = -1;
+    m_multigrid_stale = !ok;
+    m_iterations_per_decade = -1.0;
+    return ok;
+  };
+  // Multigrid could not solve this system: CHOLMOD decides. If A factorises, multigrid is not up
+  // to this problem and CHOLMOD takes every later solve; if not, A is indefinite (Newton then
+  // projects) and multigrid stays for the next matrix.
+  auto direct = [&] {
+    m_multigrid_stale = true;
+    ++m_direct_fallbacks;
+    if (!solve_cholmod(A, b, x)) return false;
+    m_kind = LinearSolverKind::cholmod;
+    m_multigrid.reset();
+    return true;
+  };
+  bool fresh = false;
+  if (m_multigrid_stale) {
+    if (!setup()) return direct();  // the coarsest Galerkin operator does not factorise
     fresh = true;
   } else {
     m_multigrid->update_finest(A);
@@ -143,32 +160,23 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
   int iterations = multigrid_pcg(A, b, x);
   if (iterations == -1 && !fresh) {
     // Stale coarse levels: set up on this matrix and try once more.
-    ++m_multigrid_setups;
-    ++m_factorizations;
-    const bool ok = m_multigrid->setup(A);
-    m_multigrid_setup_seconds += m_multigrid->setup_seconds();
-    if (!ok) {
-      m_multigrid_stale = true;
-      return false;
-    }
-    m_iterations_after_setup = -1;
+    if (!setup()) return direct();
     iterations = multigrid_pcg(A, b, x);
   }
-  if (iterations == -1) {
-    // Not converged on a fresh hierarchy (a hard system: thin, nearly incompressible): this
-    // solve is direct.
-    m_multigrid_stale = true;
-    ++m_direct_fallbacks;
-    return solve_cholmod(A, b, x);
-  }
-  if (iterations < 0) {  // negative curvature: A is not positive definite
+  if (iterations == -1) return direct();  // no convergence on a fresh hierarchy
+  if (iterations < 0) {                   // negative curvature: A is not positive definite
     m_multigrid_stale = true;
     return false;
   }
-  if (m_iterations_after_setup < 0)
-    m_iterations_after_setup = iterations;
-  else if (iterations > 2 * m_iterations_after_setup + 4)
-    m_multigrid_stale = true;
+  // Staleness in iterations per decade of residual reduction (tolerances differ between solves).
+  if (iterations > 0) {
+    const double decades = std::max(1.0, -std::log10(m_relative_tolerance));
+    const double rate = iterations / decades;
+    if (m_iterations_per_decade < 0.0)
+      m_iterations_per_decade = rate;
+    else if (rate > 2.0 * m_iterations_per_decade + 1.0)
+      m_multigrid_stale = true;
+  }
   return true;
 }
 

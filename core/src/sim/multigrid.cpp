@@ -26,9 +26,13 @@ void NestedSpaces::check() const {
     if (static_cast<Index>(injections[k].size()) != P.cols())
       throw std::invalid_argument("NestedSpaces: injection " + std::to_string(k) +
                                   " has the wrong size");
+    std::vector<int> row_entries(P.rows(), 0);
+    for (Index c = 0; c < P.outerSize(); ++c)
+      for (SparseMatrixd::InnerIterator it(P, c); it; ++it)
+        if (it.value() != 0.0) ++row_entries[it.row()];
     for (Index j = 0; j < P.cols(); ++j) {
       const Index i = injections[k][j];
-      if (i < 0 || i >= P.rows() || P.coeff(i, j) != 1.0)
+      if (i < 0 || i >= P.rows() || P.coeff(i, j) != 1.0 || row_entries[i] != 1)
         throw std::invalid_argument("NestedSpaces: injection " + std::to_string(k) +
                                     " is not a unit row at coarse vertex " + std::to_string(j));
     }
@@ -42,9 +46,14 @@ std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
   const int levels = spaces.num_levels();
   // free index of each DOF per level (−1: constrained), finest last.
   std::vector<std::vector<Index>> free_index(levels);
-  free_index[levels - 1].assign(3 * spaces.num_fine_vertices(), -1);
-  for (std::size_t i = 0; i < free_dofs.size(); ++i)
+  const Index num_dofs = 3 * spaces.num_fine_vertices();
+  free_index[levels - 1].assign(num_dofs, -1);
+  for (std::size_t i = 0; i < free_dofs.size(); ++i) {
+    if (free_dofs[i] < 0 || free_dofs[i] >= num_dofs || (i > 0 && free_dofs[i] <= free_dofs[i - 1]))
+      throw std::invalid_argument("free_dof_prolongations: free DOF " + std::to_string(i) +
+                                  " is not an ascending index below " + std::to_string(num_dofs));
     free_index[levels - 1][free_dofs[i]] = static_cast<Index>(i);
+  }
   for (int k = levels - 2; k >= 0; --k) {
     const std::vector<Index>& injection = spaces.injections[k];
     std::vector<Index>& index = free_index[k];
@@ -198,10 +207,7 @@ MultigridPreconditioner::MultigridPreconditioner(std::vector<SparseMatrixd> prol
 MultigridPreconditioner::~MultigridPreconditioner() = default;
 
 std::vector<Index> MultigridPreconditioner::level_sizes() const {
-  std::vector<Index> sizes;
-  for (const auto& level : m_levels)
-    sizes.push_back(level->A != nullptr ? level->A->rows() : 0);
-  return sizes;
+  return m_sizes;
 }
 
 bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
@@ -219,6 +225,9 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   }
   for (int k = 1; k <= L; ++k)
     setup_smoother(*m_levels[k]);
+  m_sizes.clear();
+  for (const auto& level : m_levels)
+    m_sizes.push_back(level->A->rows());
   const SparseMatrixd& A0 = *m_levels[0]->A;
   if (!m_coarse->analysed || m_coarse->nonzeros != A0.nonZeros()) {
     m_coarse->llt.analyzePattern(A0);
@@ -232,7 +241,8 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
 
 void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {
   Level& finest = *m_levels.back();
-  if (finest.A == nullptr || finest.A->rows() != A.rows())
+  // The previous finest matrix may be gone: compare with the size recorded at setup.
+  if (m_sizes.empty() || m_sizes.back() != A.rows())
     throw std::logic_error("MultigridPreconditioner::update_finest before setup or size change");
   finest.A = &A;
   if (num_levels() == 1) return;
@@ -289,7 +299,17 @@ void MultigridPreconditioner::setup_smoother(Level& level) {
                  .eigenvalues()
                  .maxCoeff();
   }
-  level.lambda_max = 1.1 * lambda;
+  // A Ritz value bounds λ_max from below; the Chebyshev polynomial stays below 1 in magnitude
+  // up to 2θ = upper + lower, so the upper end gets a margin, capped by the row-sum (Gershgorin)
+  // bound of D⁻¹A, which holds for any matrix.
+  double gershgorin = 0.0;
+  for (Index j = 0; j < A.outerSize(); ++j) {
+    double sum = 0.0;
+    for (SparseMatrixd::InnerIterator it(A, j); it; ++it)
+      sum += std::abs(it.value());
+    gershgorin = std::max(gershgorin, sum * level.inverse_diagonal[j]);
+  }
+  level.lambda_max = std::min(1.2 * lambda, std::max(gershgorin, lambda));
   level.lambda_min = m_options.chebyshev_lower * lambda;
 }
 

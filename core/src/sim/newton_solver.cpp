@@ -52,10 +52,11 @@ class HessianChoice {
 };
 
 /// Relative tolerance of each iterative linear solve (inexact Newton, Eisenstat & Walker 1996,
-/// choice 2 with γ = 0.9, α = 2 and their safeguard): η_k = γ (‖g_k‖ / ‖g_{k−1}‖)², at most
-/// kMaxForcing (and kMaxForcing for the first solve); never tighter than needed to bring the
-/// residual to half the target in one step, never tighter than 10⁻¹². Near the solution η follows
-/// ‖g‖, which keeps Newton's convergence quadratic.
+/// choice 2 with γ = 0.9, α = 2): η_k = γ (‖g_k‖ / ‖g_{k−1}‖)², at most kMaxForcing (and
+/// kMaxForcing for the first solve); never tighter than needed to bring the residual to half the
+/// target in one step, never tighter than 10⁻¹². (Their safeguard against η falling too fast only
+/// acts above 0.1, which the cap excludes.) Near the solution η follows ‖g‖, which keeps Newton's
+/// convergence quadratic.
 class InexactNewtonForcing {
  public:
   static constexpr double kMaxForcing = 1e-4;
@@ -64,22 +65,17 @@ class InexactNewtonForcing {
     double eta = kMaxForcing;
     if (m_previous_residual > 0.0) {
       const double ratio = residual / m_previous_residual;
-      eta = 0.9 * ratio * ratio;
-      const double safeguard = 0.9 * m_previous_eta * m_previous_eta;
-      if (safeguard > 0.1) eta = std::max(eta, safeguard);
-      eta = std::min(eta, kMaxForcing);
+      eta = std::min(0.9 * ratio * ratio, kMaxForcing);
     }
     if (residual > 0.0) eta = std::max(eta, std::min(0.5, 0.5 * m_target / residual));
     eta = std::max(eta, 1e-12);
     m_previous_residual = residual;
-    m_previous_eta = eta;
     return eta;
   }
 
  private:
   double m_target;
   double m_previous_residual = 0.0;
-  double m_previous_eta = 0.0;
 };
 
 }  // namespace

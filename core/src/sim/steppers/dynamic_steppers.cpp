@@ -28,7 +28,7 @@ NewtonResult BackwardEulerStepper::step(double t0, double, double h, VectorXd& q
 }
 
 NewtonResult SymplecticEulerStepper::step(double t0, double, double h, VectorXd& q, VectorXd& v) {
-  symplectic_euler_step(m_problem, t0, h, q, v);
+  symplectic_euler_step(m_problem, t0, h, q, v, &m_scratch);
   return explicit_result();
 }
 

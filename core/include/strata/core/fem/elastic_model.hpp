@@ -50,7 +50,8 @@ class ElasticModel {
   /// The stiffness sparsity pattern (values zero), column-major, 3·#V square.
   const SparseMatrixd& stiffness_pattern() const { return m_pattern; }
 
-  /// Smallest J = det F over the tets and the index of that tet.
+  /// Smallest J = det F over the tets and the index of that tet (a NaN counts as smallest; ties
+  /// go to the smaller index). Parallel.
   std::pair<double, Index> min_volume_ratio(ConstRef<VectorXd> x) const;
   /// Green strain, Cauchy stress and von Mises stress per tet.
   TetFields tet_fields(ConstRef<VectorXd> x) const;
@@ -72,9 +73,10 @@ class ElasticModel {
   VectorXd m_rest_positions;
   /// Parallel schedule; the arrays below are in its sorted tet order.
   TetPartition m_partition;
-  std::vector<int> m_sorted_tets;       ///< 4 per tet
-  std::vector<double> m_sorted_Dm_inv;  ///< 9 per tet, column-major
-  std::vector<double> m_sorted_volume;  ///< 1 per tet
+  std::vector<int> m_sorted_tets;           ///< 4 per tet
+  std::vector<double> m_sorted_Dm_inv;      ///< 9 per tet, column-major
+  std::vector<double> m_sorted_volume;      ///< 1 per tet
+  std::vector<double> m_sorted_Dm_inv_det;  ///< det Dm⁻¹, 1 per tet
   /// Dm⁻¹ and rest volume in lane groups for the vectorised kernels, kLaneRest per group.
   static constexpr int kLaneRest = 40;
   std::vector<double> m_lane_rest;

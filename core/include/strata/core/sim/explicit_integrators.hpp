@@ -8,9 +8,16 @@
 
 namespace strata {
 
+/// Vectors an explicit step reuses from the previous one (no allocation per step).
+struct ExplicitScratch {
+  VectorXd forces;
+};
+
 /// Symplectic (semi-implicit) Euler from time t: v ← v + h a(x, v), then x ← x + h v.
-/// One force evaluation per step; energy oscillates without secular drift.
-void symplectic_euler_step(const Problem& system, double t, double h, VectorXd& x, VectorXd& v);
+/// One force evaluation per step; energy oscillates without secular drift. Without damping the
+/// update is one parallel pass over the DOFs after the force evaluation.
+void symplectic_euler_step(const Problem& system, double t, double h, VectorXd& x, VectorXd& v,
+                           ExplicitScratch* scratch = nullptr);
 
 /// Classical fourth-order Runge–Kutta on (x, v)' = (v, a(x, v)) from time t; the Dirichlet DOFs'
 /// stage velocities and accelerations are the prescribed ones at each stage time.

@@ -14,10 +14,12 @@
 /// Multigrid (multigrid.hpp): CG preconditioned by a V-cycle over nested coarser spaces, to the
 /// relative tolerance. The coarse operators of one setup serve the following solves
 /// (Newton matrices of one step, and of later steps, are close) until a solve needs more than
-/// twice the iterations of the solve right after the setup (plus 4), fails, or meets negative
-/// curvature; then the next solve sets up anew. The finest level's smoother always uses the
-/// current matrix. A system multigrid-PCG does not solve within 500 iterations on a fresh
-/// hierarchy is solved by CHOLMOD (counted, direct_fallbacks).
+/// twice the iterations per decade of residual reduction of the first solve after the setup
+/// (plus one), fails, or meets negative curvature; then the next solve sets up anew. The finest
+/// level's smoother always uses the current matrix. When multigrid cannot solve a system (no
+/// convergence within 500 iterations on a fresh hierarchy, or a coarsest operator that does not
+/// factorise), CHOLMOD solves it (counted, direct_fallbacks): if A factorises, CHOLMOD takes every
+/// later solve (kind() becomes cholmod); if not, A is indefinite and the solve fails.
 #include <memory>
 #include <vector>
 
@@ -95,7 +97,7 @@ class SpdSolver {
   long m_multigrid_setups = 0;
   double m_multigrid_setup_seconds = 0.0;
   bool m_multigrid_stale = true;
-  long m_iterations_after_setup = -1;
+  double m_iterations_per_decade = -1.0;  ///< of the first solve after the last setup
   std::unique_ptr<MultigridPreconditioner> m_multigrid;
   bool solve_with_previous_factor(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   bool solve_cholmod(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);

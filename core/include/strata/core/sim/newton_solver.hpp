@@ -10,9 +10,10 @@
 /// iterations before it is tried again. Plain CG (incomplete Cholesky) uses the projected Hessian
 /// only; multigrid-PCG tries the exact one and refuses it on negative curvature.
 ///
-/// Inexact Newton: iterative linear solves stop at a relative residual η_k that follows the
-/// Newton residual (Eisenstat–Walker; at most 10⁻⁴, never tighter than needed to reach the target
-/// in one step); a direct solve is exact anyway.
+/// Inexact Newton: the iterative linear solves (CG on a previous Cholesky factor, multigrid-PCG)
+/// stop at a relative residual η_k that follows the Newton residual (Eisenstat–Walker; at most
+/// 10⁻⁴, never tighter than needed to reach the target in one step); a fresh factorisation solves
+/// exactly, incomplete-Cholesky CG keeps its own tolerance.
 ///
 /// Convergence, whichever comes first:
 ///   - residual: ‖g_free‖ ≤ max(tolerance · force_scale, residual_floor);

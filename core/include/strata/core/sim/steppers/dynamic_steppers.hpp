@@ -26,6 +26,7 @@ class SymplecticEulerStepper final : public TimeStepper {
 
  private:
   const Problem& m_problem;
+  ExplicitScratch m_scratch;
 };
 
 class Rk4Stepper final : public TimeStepper {
