@@ -1,0 +1,409 @@
+#!/usr/bin/python3
+"""Cost against accuracy of one scene: full resolution, every uniform level, adaptive sweeps.
+
+  experiment.py SPEC.json [--out DIR] [--strata PATH] [--jobs N] [--list] [--only RUN]
+                          [--report-only] [--threads N] [--set key.path=value ...]
+
+SPEC.json (paths relative to the spec file):
+
+  {"name": "slab_press_dynamic",                      # folder name under --out
+   "scene": "../scenes/slab_press_dynamic_tolerance.json",   # must have a "hierarchy" key
+   "tolerances": [0.05, 0.02, 0.01, 0.005],           # adaptive runs, hierarchy.tolerance
+   "uniform_levels": "all",                           # or a list of levels below hierarchy.levels
+   "set": {"solver.duration": 0.04}}                  # overrides applied to every run (optional)
+
+Every run uses the scene's time stepping unchanged. Per run the sweep records wall and CPU time
+(of the strata process), element evaluations, Newton and CG iterations, the largest active tets
+and DOFs, cut changes, redone steps, the run's own estimated error and the error against full
+resolution: the largest probe-displacement difference over every frame and probe, relative to the
+largest full-resolution probe displacement (what hierarchy.tolerance bounds). It writes
+OUT/NAME/results.csv, results.json and the charts error_vs_cost.png and adaptive_over_time.png.
+
+Resuming: each run lives in OUT/NAME/runs/<run>-<hash>/, the hash taken over the scene file's
+bytes, the spec's overrides and the run's settings; `run.json` is written there last, after the
+run's outputs are complete, and a run with a `run.json` is skipped. A killed sweep therefore
+resumes where it stopped, and changing the scene or the overrides starts afresh.
+
+Spreading runs: --jobs N runs N at once (each with cores/N threads); --list prints one command
+per run (`experiment.py SPEC --only RUN`) for a scheduler (a Slurm job array, GNU parallel), and
+--report-only builds the tables and charts from whatever runs have finished.
+"""
+import argparse
+import concurrent.futures
+import csv
+import hashlib
+import json
+import os
+import shlex
+import subprocess
+import sys
+import threading
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def fail(message):
+    sys.exit(f"experiment: {message}")
+
+
+def load_spec(path):
+    try:
+        with open(path) as f:
+            spec = json.load(f)
+    except (OSError, json.JSONDecodeError) as error:
+        fail(f"{path}: {error}")
+    for key in spec:
+        if key not in ("name", "scene", "tolerances", "uniform_levels", "set"):
+            fail(f"{path}: unknown key '{key}' (valid: name, scene, tolerances, uniform_levels, set)")
+    if "scene" not in spec:
+        fail(f"{path}: 'scene' is required")
+    spec["scene"] = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)),
+                                                  spec["scene"]))
+    spec.setdefault("name", os.path.splitext(os.path.basename(path))[0])
+    spec.setdefault("tolerances", [0.05, 0.02, 0.01, 0.005])
+    spec.setdefault("uniform_levels", "all")
+    spec.setdefault("set", {})
+    if not isinstance(spec["set"], dict):
+        fail(f"{path}: 'set' must be an object of key.path: value")
+    for i, tolerance in enumerate(spec["tolerances"]):
+        if not isinstance(tolerance, (int, float)) or not 0 < tolerance < 1:
+            fail(f"{path}: tolerances.{i}: must be a number in (0, 1)")
+    try:
+        with open(spec["scene"], "rb") as f:
+            spec["scene_bytes"] = f.read()
+        scene = json.loads(spec["scene_bytes"])
+    except (OSError, json.JSONDecodeError) as error:
+        fail(f"{path}: scene: {error}")
+    if "hierarchy" not in scene:
+        fail(f"{path}: scene {spec['scene']} has no 'hierarchy' key")
+    levels = spec["set"].get("hierarchy.levels", scene["hierarchy"].get("levels", 2))
+    if spec["uniform_levels"] == "all":
+        spec["uniform_levels"] = list(range(levels))
+    for i, level in enumerate(spec["uniform_levels"]):
+        if not isinstance(level, int) or not 0 <= level < levels:
+            fail(f"{path}: uniform_levels.{i}: must be an integer in 0..{levels - 1}")
+    spec["levels"] = levels
+    return spec
+
+
+def planned_runs(spec):
+    """(name, kind, settings) of every run of the sweep, the reference first."""
+    runs = [("full", "full", {"hierarchy.mode": "full"})]
+    for level in spec["uniform_levels"]:
+        runs.append((f"uniform-{level}", "uniform",
+                     {"hierarchy.mode": "uniform", "hierarchy.level": level}))
+    for tolerance in spec["tolerances"]:
+        runs.append((f"adaptive-{tolerance:g}", "adaptive",
+                     {"hierarchy.mode": "adaptive", "hierarchy.tolerance": tolerance}))
+    return runs
+
+
+def run_folder(args, spec, name, settings):
+    digest = hashlib.sha256()
+    digest.update(spec["scene_bytes"])
+    digest.update(json.dumps(spec["set"], sort_keys=True).encode())
+    digest.update(json.dumps(settings, sort_keys=True).encode())
+    return os.path.join(args.out, spec["name"], "runs", f"{name}-{digest.hexdigest()[:12]}")
+
+
+def command_for(args, spec, folder, settings, threads):
+    command = [args.strata, "run", spec["scene"], "--out", folder, "--quiet",
+               "--set", "output.vtk=false"]
+    if threads > 0:
+        command += ["--threads", str(threads)]
+    for key, value in list(spec["set"].items()) + list(settings.items()):
+        command += ["--set", f"{key}={json.dumps(value)}"]
+    return command
+
+
+def execute(args, spec, name, settings, threads):
+    """Runs one configuration unless it has finished before; returns its run.json record."""
+    folder = run_folder(args, spec, name, settings)
+    marker = os.path.join(folder, "run.json")
+    if os.path.exists(marker):
+        with open(marker) as f:
+            return json.load(f)
+    os.makedirs(folder, exist_ok=True)
+    command = command_for(args, spec, folder, settings, threads)
+    start = time.monotonic()
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    stderr_text = []
+    reader = threading.Thread(target=lambda: stderr_text.append(process.stderr.read()))
+    reader.start()
+    _, status, usage = os.wait4(process.pid, 0)
+    reader.join()
+    process.returncode = os.waitstatus_to_exitcode(status)
+    record = {"name": name, "settings": settings, "command": command,
+              "returncode": process.returncode, "wall_seconds": time.monotonic() - start,
+              "cpu_seconds": usage.ru_utime + usage.ru_stime,
+              "system_seconds": usage.ru_stime,
+              "stderr": stderr_text[0].decode(errors="replace")[-2000:] if stderr_text else ""}
+    if process.returncode == 0 and not os.path.exists(os.path.join(folder, "stats.json")):
+        record["returncode"] = -1
+        record["stderr"] += "\nno stats.json written"
+    # run.json last and atomically: its presence means the outputs are complete.
+    temporary = marker + ".part"
+    with open(temporary, "w") as f:
+        json.dump(record, f, indent=1)
+    os.replace(temporary, marker)
+    return record
+
+
+def read_probes(folder):
+    frames = {}
+    path = os.path.join(folder, "probes.csv")
+    if not os.path.exists(path):
+        return frames
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            key = (round(float(row["time"]), 12), int(row["probe"]))
+            frames[key] = (float(row["ux"]), float(row["uy"]), float(row["uz"]))
+    return frames
+
+
+def error_against(reference, frames):
+    """(largest |Δu| over frames and probes / largest |u_ref|, per-time errors) or None."""
+    scale = max((sum(c * c for c in u) ** 0.5 for u in reference.values()), default=0.0)
+    if scale == 0.0 or not frames:
+        return None, {}
+    worst, per_time = 0.0, {}
+    for key, u_ref in reference.items():
+        if key not in frames:
+            return None, {}
+        d = sum((a - b) ** 2 for a, b in zip(frames[key], u_ref)) ** 0.5 / scale
+        worst = max(worst, d)
+        per_time[key[0]] = max(per_time.get(key[0], 0.0), d)
+    return worst, per_time
+
+
+def summarise(args, spec):
+    """Rows of every finished run, with errors against the full run when it has finished."""
+    rows = []
+    reference = None
+    for name, kind, settings in planned_runs(spec):
+        folder = run_folder(args, spec, name, settings)
+        marker = os.path.join(folder, "run.json")
+        if not os.path.exists(marker):
+            continue
+        with open(marker) as f:
+            record = json.load(f)
+        row = {"run": name, "kind": kind, "status": "failed" if record["returncode"] else "ok",
+               "wall_seconds": record["wall_seconds"], "cpu_seconds": record["cpu_seconds"],
+               "folder": os.path.relpath(folder, os.path.join(args.out, spec["name"]))}
+        if kind == "uniform":
+            row["level"] = settings["hierarchy.level"]
+        if kind == "adaptive":
+            row["tolerance"] = settings["hierarchy.tolerance"]
+        stats_path = os.path.join(folder, "stats.json")
+        if os.path.exists(stats_path):
+            with open(stats_path) as f:
+                stats = json.load(f)
+            hierarchy = stats.get("hierarchy", {})
+            history = hierarchy.get("history", {})
+            row.update({
+                "status": stats.get("status", row["status"]),
+                "strata_wall_seconds": stats.get("wall_seconds"),
+                "element_evaluations": stats.get("element_evaluations"),
+                "newton_iterations": stats.get("newton_iterations"),
+                "linear_iterations": stats.get("newton", {}).get("linear_iterations"),
+                "linear_solver": stats.get("newton", {}).get("linear_solver"),
+                "max_active_tets": max(history.get("tets") or [stats.get("tets", 0)]),
+                "max_dofs": max(history.get("dofs") or [stats.get("dofs", 0)]),
+                "cut_changes": len(hierarchy.get("changes", [])),
+                "redone_steps": hierarchy.get("redone_steps", 0),
+                "estimated_error": hierarchy.get("estimated_error"),
+                "tolerance_met": hierarchy.get("tolerance_met"),
+                "history": {k: history.get(k, []) for k in ("time", "tets", "dofs",
+                                                             "estimated_error")},
+            })
+        row["probes"] = read_probes(folder)
+        if name == "full" and row["status"] == "ok":
+            reference = row["probes"]
+        rows.append(row)
+    for row in rows:
+        error, per_time = (None, {}) if reference is None else error_against(reference,
+                                                                             row["probes"])
+        row["error"] = error
+        row["error_over_time"] = sorted(per_time.items())
+        del row["probes"]
+    full = next((r for r in rows if r["run"] == "full"), None)
+    for row in rows:
+        if full is not None and row.get("wall_seconds"):
+            row["speedup"] = full["wall_seconds"] / row["wall_seconds"]
+        if row.get("error") and row.get("estimated_error") is not None and row["kind"] == "adaptive":
+            row["effectivity"] = row["estimated_error"] / row["error"]
+    return rows
+
+
+COLUMNS = ["run", "kind", "level", "tolerance", "status", "error", "estimated_error",
+           "effectivity", "tolerance_met", "wall_seconds", "cpu_seconds", "speedup",
+           "max_active_tets", "max_dofs", "element_evaluations", "newton_iterations",
+           "linear_iterations", "linear_solver", "cut_changes", "redone_steps", "folder"]
+
+
+def write_results(args, spec, rows):
+    folder = os.path.join(args.out, spec["name"])
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "results.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: row.get(k, "") for k in COLUMNS})
+    with open(os.path.join(folder, "results.json"), "w") as f:
+        json.dump({"scene": spec["scene"], "set": spec["set"], "levels": spec["levels"],
+                   "runs": rows}, f, indent=1)
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("experiment: matplotlib not found (run with /usr/bin/python3): no charts",
+              file=sys.stderr)
+        return
+    ok = [r for r in rows if r["status"] == "ok" and r.get("error") is not None]
+    figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for axis, cost, label in ((axes[0], "wall_seconds", "wall time [s]"),
+                              (axes[1], "max_dofs", "largest active DOFs")):
+        for kind, style in (("uniform", "s-"), ("adaptive", "o-")):
+            points = sorted((r[cost], max(r["error"], 1e-6), r) for r in ok if r["kind"] == kind)
+            if points:
+                axis.plot([p[0] for p in points], [p[1] for p in points], style, label=kind)
+                for x, y, r in points:
+                    axis.annotate(f"L{r['level']}" if kind == "uniform" else f"τ={r['tolerance']:g}",
+                                  (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        full = next((r for r in rows if r["run"] == "full"), None)
+        if full is not None and full.get(cost):
+            axis.axvline(full[cost], color="k", linestyle=":", label="full resolution")
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        axis.set_xlabel(label)
+        axis.set_ylabel("error vs full resolution (below 1e-6: at 1e-6)")
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend(fontsize=8)
+    figure.suptitle(f"{spec['name']}: error against cost")
+    figure.tight_layout()
+    figure.savefig(os.path.join(folder, "error_vs_cost.png"), dpi=120)
+    plt.close(figure)
+
+    adaptive = [r for r in ok if r["kind"] == "adaptive" and r.get("history")]
+    if adaptive:
+        figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        for r in adaptive:
+            h = r["history"]
+            line, = axes[0].plot(h["time"], h["dofs"], label=f"τ={r['tolerance']:g}")
+            times = [t for t, _ in r["error_over_time"]]
+            axes[1].plot(times, [max(e, 1e-6) for _, e in r["error_over_time"]], "-",
+                         color=line.get_color(), label=f"true, τ={r['tolerance']:g}")
+            axes[1].plot(h["time"], [max(e, 1e-6) for e in h["estimated_error"]], "--",
+                         color=line.get_color(), label=f"estimated, τ={r['tolerance']:g}")
+        axes[0].set_xlabel("time [s] (static: load factor)")
+        axes[0].set_ylabel("active DOFs")
+        axes[1].set_xlabel("time [s] (static: load factor)")
+        axes[1].set_ylabel("error")
+        axes[1].set_yscale("log")
+        for axis in axes:
+            axis.grid(True, alpha=0.3)
+            axis.legend(fontsize=7)
+        figure.suptitle(f"{spec['name']}: adaptive runs over time")
+        figure.tight_layout()
+        figure.savefig(os.path.join(folder, "adaptive_over_time.png"), dpi=120)
+        plt.close(figure)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("spec")
+    parser.add_argument("--out", default=os.path.join(REPO, "out", "experiments"))
+    parser.add_argument("--strata", default=os.environ.get("STRATA") or os.path.join(
+        REPO, "build", "experiments", "cli", "strata"))
+    parser.add_argument("--jobs", type=int, default=1, help="runs at once")
+    parser.add_argument("--threads", type=int, default=0,
+                        help="threads per run (default: cores / jobs)")
+    parser.add_argument("--list", action="store_true", help="print one command per run")
+    parser.add_argument("--only", help="run just this run (see --list)")
+    parser.add_argument("--report-only", action="store_true",
+                        help="tables and charts from the finished runs; run nothing")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="an override for every run, added to the spec's (value as JSON)")
+    args = parser.parse_args()
+    spec = load_spec(args.spec)
+    for item in args.set:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            fail(f"--set {item}: expected key.path=value")
+        try:
+            spec["set"][key] = json.loads(value)
+        except json.JSONDecodeError:
+            spec["set"][key] = value
+    runs = planned_runs(spec)
+    if args.list:
+        for name, _, _ in runs:
+            command = [sys.executable, os.path.abspath(__file__), os.path.abspath(args.spec),
+                       "--out", os.path.abspath(args.out), "--strata", args.strata, "--only", name]
+            for item in args.set:
+                command += ["--set", item]
+            print(" ".join(shlex.quote(a) for a in command))
+        return
+    if args.only:
+        runs = [r for r in runs if r[0] == args.only]
+        if not runs:
+            fail(f"--only {args.only}: no such run (see --list)")
+    if args.jobs < 1:
+        fail("--jobs must be >= 1")
+    if not args.report_only:
+        if not os.access(args.strata, os.X_OK):
+            fail(f"{args.strata} is not an executable (build strata or pass --strata)")
+        threads = args.threads or max(1, (os.cpu_count() or 1) // args.jobs)
+        pending = [r for r in runs
+                   if not os.path.exists(os.path.join(run_folder(args, spec, r[0], r[2]),
+                                                      "run.json"))]
+        done, durations, start = len(runs) - len(pending), [], time.monotonic()
+        running = set()
+        lock = threading.Lock()
+
+        def progress():
+            mean = sum(durations) / len(durations) if durations else None
+            left = len(runs) - done
+            eta = f"{mean * left / args.jobs:.0f} s" if mean is not None else "?"
+            names = ", ".join(sorted(running)) or "-"
+            print(f"\rexperiment {spec['name']}: {done}/{len(runs)} done, running {names}, "
+                  f"elapsed {time.monotonic() - start:.0f} s, sweep ETA {eta}   ",
+                  end="", file=sys.stderr, flush=True)
+
+        def one(run):
+            nonlocal done
+            with lock:
+                running.add(run[0])
+                progress()
+            record = execute(args, spec, run[0], run[2], threads)
+            with lock:
+                running.discard(run[0])
+                done += 1
+                durations.append(record["wall_seconds"])
+                if record["returncode"] != 0:
+                    print(f"\nexperiment: {run[0]} failed ({record['returncode']}): "
+                          f"{record['stderr'].strip().splitlines()[-1:]}", file=sys.stderr)
+                progress()
+
+        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            list(pool.map(one, pending))
+        print(file=sys.stderr)
+    if args.only:
+        # One run of a spread sweep: the report is built once, with --report-only.
+        print(f"experiment: {args.only} done; build the report with --report-only")
+        return
+    rows = summarise(args, spec)
+    write_results(args, spec, rows)
+    for row in rows:
+        error = "-" if row.get("error") is None else f"{100 * row['error']:.3g} %"
+        estimate = row.get("estimated_error")
+        estimate = "-" if estimate is None else f"{100 * estimate:.3g} %"
+        print(f"{row['run']:>16}  {row['status']:>8}  error {error:>9}  estimated {estimate:>9}  "
+              f"wall {row['wall_seconds']:7.2f} s  speed-up {row.get('speedup', 0):5.2f}x  "
+              f"DOFs {row.get('max_dofs', '-')}")
+    print(f"experiment: results in {os.path.join(args.out, spec['name'])}")
+
+
+if __name__ == "__main__":
+    main()
