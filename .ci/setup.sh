@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Prepares a Debian 12 machine and builds strata: installs the Debian packages that are missing
 # (apt-get, as root or through sudo), configures a Release build in build/ once, then builds
-# everything. Idempotent: with all packages present and the build up to date it takes seconds.
+# everything (or the targets in STRATA_BUILD_TARGETS). Idempotent: with all packages present and
+# the build up to date it takes seconds.
 #
 # Environment: STRATA_BUILD_DIR (default <repo>/build), STRATA_JOBS (default: number of cores).
 set -euo pipefail
@@ -51,7 +52,12 @@ if [[ ! -f "${build_dir}/CMakeCache.txt" ]]; then
 elif [[ ! -f "${build_dir}/data/models/armadillo.off" ]]; then
   cmake -S "${repo_root}" -B "${build_dir}"
 fi
-cmake --build "${build_dir}" -j "${jobs}"
+# STRATA_BUILD_TARGETS (space-separated): build only these targets (the demo builds `strata`).
+targets=()
+for target in ${STRATA_BUILD_TARGETS:-}; do
+  targets+=(--target "${target}")
+done
+cmake --build "${build_dir}" -j "${jobs}" "${targets[@]}"
 end=$(date +%s.%N)
 awk -v s="${start}" -v e="${end}" -v d="${build_dir}" -v j="${jobs}" \
   'BEGIN { printf "setup: build of %s took %.1f s (%d jobs)\n", d, e - s, j }'

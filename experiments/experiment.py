@@ -10,7 +10,8 @@ SPEC.json (paths relative to the spec file):
    "scene": "../scenes/slab_press_dynamic_tolerance.json",   # must have a "hierarchy" key
    "tolerances": [0.05, 0.02, 0.01, 0.005],           # adaptive runs, hierarchy.tolerance
    "uniform_levels": "all",                           # or a list of levels below hierarchy.levels
-   "set": {"solver.duration": 0.04}}                  # overrides applied to every run (optional)
+   "set": {"solver.duration": 0.04},                  # overrides applied to every run (optional)
+   "quick": {"set": {...}, "tolerances": [...]}}      # the short version run with --quick
 
 Every run uses the scene's time stepping unchanged. Per run the sweep records wall and CPU time
 (of the strata process), element evaluations, Newton and CG iterations, the largest active tets
@@ -47,15 +48,16 @@ def fail(message):
     sys.exit(f"experiment: {message}")
 
 
-def load_spec(path):
+def load_spec(path, quick=False):
     try:
         with open(path) as f:
             spec = json.load(f)
     except (OSError, json.JSONDecodeError) as error:
         fail(f"{path}: {error}")
     for key in spec:
-        if key not in ("name", "scene", "tolerances", "uniform_levels", "set"):
-            fail(f"{path}: unknown key '{key}' (valid: name, scene, tolerances, uniform_levels, set)")
+        if key not in ("name", "scene", "tolerances", "uniform_levels", "set", "quick"):
+            fail(f"{path}: unknown key '{key}' (valid: name, scene, tolerances, uniform_levels, "
+                 "set, quick)")
     if "scene" not in spec:
         fail(f"{path}: 'scene' is required")
     spec["scene"] = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)),
@@ -66,6 +68,13 @@ def load_spec(path):
     spec.setdefault("set", {})
     if not isinstance(spec["set"], dict):
         fail(f"{path}: 'set' must be an object of key.path: value")
+    if quick:
+        block = spec.get("quick", {})
+        for key in block:
+            if key not in ("set", "tolerances"):
+                fail(f"{path}: quick: unknown key '{key}' (valid: set, tolerances)")
+        spec["set"] = {**spec["set"], **block.get("set", {})}
+        spec["tolerances"] = block.get("tolerances", spec["tolerances"])
     for i, tolerance in enumerate(spec["tolerances"]):
         if not isinstance(tolerance, (int, float)) or not 0 < tolerance < 1:
             fail(f"{path}: tolerances.{i}: must be a number in (0, 1)")
@@ -324,10 +333,12 @@ def main():
     parser.add_argument("--only", help="run just this run (see --list)")
     parser.add_argument("--report-only", action="store_true",
                         help="tables and charts from the finished runs; run nothing")
+    parser.add_argument("--quick", action="store_true",
+                        help="the spec's short version: its 'quick' overrides and tolerances")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="an override for every run, added to the spec's (value as JSON)")
     args = parser.parse_args()
-    spec = load_spec(args.spec)
+    spec = load_spec(args.spec, args.quick)
     for item in args.set:
         key, sep, value = item.partition("=")
         if not sep or not key:
@@ -341,6 +352,8 @@ def main():
         for name, _, _ in runs:
             command = [sys.executable, os.path.abspath(__file__), os.path.abspath(args.spec),
                        "--out", os.path.abspath(args.out), "--strata", args.strata, "--only", name]
+            if args.quick:
+                command.append("--quick")
             for item in args.set:
                 command += ["--set", item]
             print(" ".join(shlex.quote(a) for a in command))

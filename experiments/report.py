@@ -1,0 +1,191 @@
+#!/usr/bin/python3
+"""The experiments report: REPORT.md from the sweeps' results (experiment.py).
+
+  report.py [--results DIR] [--out DIR] [--strata PATH] [SPEC.json ...]
+
+Reads DIR/<name>/results.json of every sweep (default out/experiments, or only those of the given
+specs), copies each sweep's charts next to the report and writes OUT/REPORT.md (default
+experiments/results): the machine, the commands, per scene a table of every run (error against
+full resolution, the run's estimate and effectivity, wall time, speed-up, active DOFs), the charts,
+and the headline figures — the speed-up over full resolution at the default tolerance (0.01) and
+of the cheapest run within 1 % error — with a plain statement wherever a target is missed:
+adaptive at least 5× cheaper than full resolution at ≤ 1 % error on the local-load scenes, and
+cheaper at equal error than every uniform level.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_TOLERANCE = 0.01
+
+
+def machine():
+    model = platform.processor() or "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    memory = "?"
+    try:
+        with open("/proc/meminfo") as f:
+            memory = f"{int(f.readline().split()[1]) / 2**20:.0f} GiB"
+    except (OSError, ValueError, IndexError):
+        pass
+    return f"{model}, {cores} cores available, {memory} memory, {platform.system()}"
+
+
+def version(strata):
+    try:
+        return subprocess.run([strata, "--version"], capture_output=True, text=True,
+                              timeout=10).stdout.strip() or "?"
+    except (OSError, subprocess.SubprocessError):
+        return "?"
+
+
+def commit():
+    try:
+        return subprocess.run(["git", "-C", REPO, "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, timeout=10).stdout.strip() or "?"
+    except (OSError, subprocess.SubprocessError):
+        return "?"
+
+
+def percent(value):
+    return "–" if value is None else f"{100 * value:.3g} %"
+
+
+def headline(runs):
+    """(speed-up at the default tolerance, (run, speed-up) of the cheapest run within 1 %)."""
+    ok = [r for r in runs if r["status"] == "ok" and r.get("error") is not None]
+    default = next((r for r in ok if r["kind"] == "adaptive"
+                    and abs(r["tolerance"] - DEFAULT_TOLERANCE) < 1e-12), None)
+    within = [r for r in ok if r["kind"] != "full" and r["error"] <= 0.01]
+    cheapest = min(within, key=lambda r: r["wall_seconds"]) if within else None
+    return default, cheapest
+
+
+def dominated(runs):
+    """Adaptive runs that some uniform level beats: no larger error at lower wall time."""
+    ok = [r for r in runs if r["status"] == "ok" and r.get("error") is not None]
+    uniform = [r for r in ok if r["kind"] == "uniform"]
+    out = []
+    for r in (r for r in ok if r["kind"] == "adaptive"):
+        for u in uniform:
+            if u["error"] <= r["error"] and u["wall_seconds"] < r["wall_seconds"]:
+                out.append((r, u))
+                break
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("specs", nargs="*")
+    parser.add_argument("--results", default=os.path.join(REPO, "out", "experiments"))
+    parser.add_argument("--out", default=os.path.join(REPO, "experiments", "results"))
+    parser.add_argument("--strata", default=os.environ.get("STRATA") or os.path.join(
+        REPO, "build", "experiments", "cli", "strata"))
+    parser.add_argument("--local-load", default="block_poke,slab_press_tolerance,"
+                        "slab_press_dynamic_tolerance",
+                        help="comma-separated sweep names held to the 5x target")
+    args = parser.parse_args()
+    if args.specs:
+        names = []
+        for spec in args.specs:
+            with open(spec) as f:
+                names.append(json.load(f).get("name", os.path.splitext(os.path.basename(spec))[0]))
+    else:
+        names = sorted(d for d in os.listdir(args.results)
+                       if os.path.exists(os.path.join(args.results, d, "results.json"))) \
+            if os.path.isdir(args.results) else []
+    if not names:
+        sys.exit(f"report: no results.json under {args.results} (run experiment.py first)")
+    local_load = set(args.local_load.split(","))
+    os.makedirs(args.out, exist_ok=True)
+    lines = ["# strata experiments: cost against accuracy", "",
+             f"Generated {datetime.date.today().isoformat()} by `experiments/report.py` from the "
+             f"sweeps of `experiments/experiment.py` (strata {version(args.strata)}, commit "
+             f"{commit()}).", "", f"Machine: {machine()}. Times are wall times of one run each "
+             "on a shared machine: compare them as ratios within one sweep.", "",
+             "Error = the largest probe-displacement difference to the full-resolution run over "
+             "every frame and probe, relative to the largest full-resolution probe displacement "
+             "(what `hierarchy.tolerance` bounds). Estimated = the run's own estimate "
+             "(`hierarchy.estimated_error`); effectivity = estimated / true.", "",
+             "## Headline", "",
+             "| scene | speed-up at τ = 0.01 (error) | cheapest run within 1 % error | target |",
+             "|---|---|---|---|"]
+    sections = []
+    for name in names:
+        path = os.path.join(args.results, name, "results.json")
+        if not os.path.exists(path):
+            sys.exit(f"report: {path} missing (run experiment.py on that spec)")
+        with open(path) as f:
+            data = json.load(f)
+        runs = data["runs"]
+        default, cheapest = headline(runs)
+        notes = []
+        if name in local_load:
+            if cheapest is None or cheapest.get("speedup", 0) < 5:
+                notes.append("**missed**: no run within 1 % error is 5× cheaper than full "
+                             "resolution")
+            else:
+                notes.append("met (≥ 5× within 1 %)")
+        for r, u in dominated(runs):
+            notes.append(f"**{r['run']} is beaten by {u['run']}** (error {percent(u['error'])} "
+                         f"in {u['wall_seconds']:.1f} s)")
+        lines.append(f"| {name} | " +
+                     (f"{default.get('speedup', 0):.2f}× ({percent(default['error'])})"
+                      if default else "–") + " | " +
+                     (f"{cheapest['run']}: {cheapest.get('speedup', 0):.2f}× "
+                      f"({percent(cheapest['error'])})" if cheapest else "none") + " | " +
+                     ("; ".join(notes) or "–") + " |")
+        target = os.path.join(args.out, name)
+        os.makedirs(target, exist_ok=True)
+        charts = []
+        for chart in ("error_vs_cost.png", "adaptive_over_time.png"):
+            source = os.path.join(args.results, name, chart)
+            if os.path.exists(source):
+                shutil.copyfile(source, os.path.join(target, chart))
+                charts.append(f"![{chart}]({name}/{chart})")
+        overrides = " ".join(f"--set {k}={json.dumps(v)}" for k, v in data.get("set", {}).items())
+        section = [f"## {name}", "", f"Scene: `{os.path.relpath(data['scene'], REPO)}`, "
+                   f"{data['levels']} levels. Command: `/usr/bin/python3 experiments/experiment.py "
+                   f"experiments/specs/{name}.json {overrides}`".rstrip() + "", "",
+                   "| run | error | estimated | effectivity | wall s | speed-up | largest DOFs | "
+                   "Newton its | CG its | cut changes | redone steps |",
+                   "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in runs:
+            section.append(
+                f"| {r['run']} | {percent(r.get('error'))} | {percent(r.get('estimated_error'))} "
+                f"| {r['effectivity']:.2f} | " if r.get("effectivity") is not None else
+                f"| {r['run']} | {percent(r.get('error'))} | {percent(r.get('estimated_error'))} "
+                f"| – | ")
+            section[-1] += (f"{r['wall_seconds']:.2f} | {r.get('speedup', 0):.2f}× | "
+                            f"{r.get('max_dofs', '–')} | {r.get('newton_iterations', '–')} | "
+                            f"{r.get('linear_iterations', '–')} | {r.get('cut_changes', '–')} | "
+                            f"{r.get('redone_steps', '–')} |")
+        section += [""] + charts + [""]
+        sections.append("\n".join(section))
+    lines += ["", "Targets: adaptive at least 5× cheaper than full resolution at ≤ 1 % error on the "
+              f"local-load scenes ({', '.join(sorted(local_load))}); no uniform level cheaper at "
+              "equal or smaller error than an adaptive run. A miss is stated in the table.", ""]
+    report = "\n".join(lines) + "\n" + "\n".join(sections)
+    temporary = os.path.join(args.out, "REPORT.md.part")
+    with open(temporary, "w") as f:
+        f.write(report)
+    os.replace(temporary, os.path.join(args.out, "REPORT.md"))
+    print(f"report: wrote {os.path.join(args.out, 'REPORT.md')} ({len(names)} scenes)")
+
+
+if __name__ == "__main__":
+    main()
