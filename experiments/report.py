@@ -89,6 +89,34 @@ def dominated(runs):
     return out
 
 
+def stability_section(folder, out):
+    """The stability map (stability_map.py) with a count of outcomes per panel."""
+    import csv
+    source = os.path.join(folder, "stability_map.png")
+    table = os.path.join(folder, "stability.csv")
+    if not os.path.exists(source) or not os.path.exists(table):
+        sys.exit(f"report: {folder} has no stability_map.png / stability.csv")
+    shutil.copyfile(source, os.path.join(out, "stability_map.png"))
+    with open(table) as f:
+        rows = list(csv.DictReader(f))
+    panels = {}
+    for r in rows:
+        key = (r["integrator"], r["material"])
+        panels.setdefault(key, {"stable": 0, "inverted": 0, "diverged": 0, "failed": 0})
+        panels[key][r["outcome"]] += 1
+    lines = ["## Stability map", "",
+             "Command: `/usr/bin/python3 experiments/stability_map.py` (`--quick` for the coarse "
+             "grid). A cantilever under gravity released from rest, every integrator and material "
+             "over Young's modulus × time step; the dashed line is the run's stable-step estimate "
+             "(the explicit integrators' element bound).", "",
+             "| integrator | material | stable | inverted | diverged |", "|---|---|---|---|---|"]
+    for (integrator, material), c in sorted(panels.items()):
+        lines.append(f"| {integrator} | {material} | {c['stable']} | {c['inverted']} | "
+                     f"{c['diverged']} |")
+    lines += ["", "![stability map](stability_map.png)", ""]
+    return "\n".join(lines)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("specs", nargs="*")
@@ -99,6 +127,7 @@ def main():
     parser.add_argument("--local-load", default="block_poke,slab_press_tolerance,"
                         "slab_press_dynamic_tolerance",
                         help="comma-separated sweep names held to the 5x target")
+    parser.add_argument("--stability", help="folder of a stability_map.py run to include")
     parser.add_argument("--bending", default="cantilever_tip_poke,thin_slab_poke",
                         help="comma-separated sweep names held to 'never slower than full'")
     args = parser.parse_args()
@@ -191,6 +220,8 @@ def main():
               f"resolution on the bending-dominated ones ({', '.join(sorted(bending))}); no uniform "
               "level cheaper at equal or smaller error than an adaptive run. A miss is stated in "
               "the table.", ""]
+    if args.stability:
+        sections.append(stability_section(args.stability, args.out))
     report = "\n".join(lines) + "\n" + "\n".join(sections)
     temporary = os.path.join(args.out, "REPORT.md.part")
     with open(temporary, "w") as f:

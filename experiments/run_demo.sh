@@ -2,8 +2,9 @@
 # Demo: installs what is missing and builds only the strata command-line tool (.ci/setup.sh with
 # STRATA_BUILD_TARGETS=strata; no tests or benchmarks), then runs the short version of the
 # experiments suite — every scene of experiments/specs at full resolution, at every uniform level
-# and adaptively at two tolerances (experiment.py --quick) — and writes the report with its
-# charts (report.py) to out/demo/REPORT.md. A few minutes on 2 cores after the build.
+# and adaptively at two tolerances (experiment.py --quick) — and the stability map on its coarse
+# grid (stability_map.py --quick), and writes the report with its charts (report.py) to
+# out/demo/REPORT.md. A few minutes on 2 cores after the build.
 #
 # Usage: ./experiments/run_demo.sh [--full]   (--full: the whole sweep, four tolerances and the
 #                                              scenes' full durations; much longer)
@@ -30,8 +31,10 @@ for spec in "${specs[@]}"; do
   /usr/bin/python3 "${repo_root}/experiments/experiment.py" "${spec}" "${quick[@]}" \
     --out "${results}" --strata "${strata}"
 done
+/usr/bin/python3 "${repo_root}/experiments/stability_map.py" "${quick[@]}" \
+  --out "${results}/stability" --strata "${strata}"
 /usr/bin/python3 "${repo_root}/experiments/report.py" "${specs[@]}" --results "${results}" \
-  --out "${report}" --strata "${strata}"
+  --out "${report}" --strata "${strata}" --stability "${results}/stability"
 echo "demo: the experiments took $(($(date +%s) - start)) s"
 echo
 echo "demo: report ${report}/REPORT.md (charts beside it); headline:"

@@ -1,0 +1,151 @@
+#!/usr/bin/python3
+"""Stability map: where each integrator and material holds or fails, over time step × stiffness.
+
+  stability_map.py [--scene SCENE.json] [--out DIR] [--strata PATH] [--jobs N] [--quick]
+
+Runs the scene (default: a 1 m cantilever of 20 × 2 × 2 cells under gravity, undamped, released
+from rest, 0.3 s) for every integrator (symplectic_euler, rk4, implicit_euler), material
+(stvk, neohookean), Young's modulus E and time step dt of the grid, and classifies each run from
+its stats.json: stable (status ok), inverted (diverged with an inverted element, which StVK and
+corotated cannot handle) or diverged (blow-up, non-finite state or Newton failure). Writes
+OUT/stability.csv and OUT/stability_map.png: one panel per integrator and material, dt against E,
+coloured by outcome, with the run's stable-step estimate (stats.json stable_dt_estimate, the
+element bound of the explicit integrators) drawn as a line. Finished runs (their stats.json) are
+kept and skipped when the map is drawn again.
+"""
+import argparse
+import concurrent.futures
+import csv
+import json
+import os
+import subprocess
+import sys
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+INTEGRATORS = ["symplectic_euler", "rk4", "implicit_euler"]
+MATERIALS = ["stvk", "neohookean"]
+DEFAULT_SCENE = {
+    "mesh": {"box": {"min": [0, 0, 0], "max": [1, 0.1, 0.1], "cells": [20, 2, 2]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e6, "poisson_ratio": 0.4,
+                 "density": 1000},
+    "gravity": [0, 0, -9.81],
+    "fixed": [{"plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}}],
+    "solver": {"mode": "dynamic", "integrator": "implicit_euler", "dt": 0.001, "duration": 0.3},
+    "output": {"every": 1000000, "vtk": False},
+}
+
+
+def classify(stats):
+    if stats.get("status") == "ok":
+        return "stable"
+    message = stats.get("message", "")
+    return "inverted" if "inverted" in message else "diverged"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--scene", help="scene file (default: the built-in cantilever)")
+    parser.add_argument("--out", default=os.path.join(REPO, "out", "stability"))
+    parser.add_argument("--strata", default=os.environ.get("STRATA") or os.path.join(
+        REPO, "build", "experiments", "cli", "strata"))
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--quick", action="store_true", help="a coarser grid (4 × 4 per panel)")
+    args = parser.parse_args()
+    if not os.access(args.strata, os.X_OK):
+        sys.exit(f"stability_map: {args.strata} is not an executable (build strata or --strata)")
+    os.makedirs(args.out, exist_ok=True)
+    scene_path = args.scene
+    if scene_path is None:
+        scene_path = os.path.join(args.out, "cantilever.json")
+        with open(scene_path, "w") as f:
+            json.dump(DEFAULT_SCENE, f, indent=1)
+    moduli = [1e4, 1e5, 1e6, 1e7] if args.quick else [1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7]
+    steps = [1e-4, 1e-3, 3e-3, 1e-2] if args.quick else [3e-5, 1e-4, 3e-4, 1e-3, 3e-3, 1e-2]
+
+    jobs = []
+    for integrator in INTEGRATORS:
+        for material in MATERIALS:
+            for E in moduli:
+                for dt in steps:
+                    name = f"{integrator}-{material}-E{E:g}-dt{dt:g}"
+                    jobs.append((name, integrator, material, E, dt))
+
+    def run(job):
+        name, integrator, material, E, dt = job
+        folder = os.path.join(args.out, "runs", name)
+        stats_path = os.path.join(folder, "stats.json")
+        if not os.path.exists(stats_path):
+            command = [args.strata, "run", scene_path, "--out", folder, "--quiet", "--threads", "1",
+                       "--set", f"solver.integrator={integrator}",
+                       "--set", f"material.model={material}",
+                       "--set", f"material.youngs_modulus={E}", "--set", f"solver.dt={dt}"]
+            subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if not os.path.exists(stats_path):
+            return job, {"status": "failed", "message": "no stats.json"}
+        with open(stats_path) as f:
+            return job, json.load(f)
+
+    rows = []
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        for k, (job, stats) in enumerate(pool.map(run, jobs)):
+            name, integrator, material, E, dt = job
+            rows.append({"integrator": integrator, "material": material, "youngs_modulus": E,
+                         "dt": dt, "outcome": classify(stats),
+                         "stable_dt_estimate": stats.get("stable_dt_estimate"),
+                         "steps": stats.get("steps"), "message": stats.get("message", "")})
+            print(f"\rstability_map: {k + 1}/{len(jobs)} runs", end="", file=sys.stderr,
+                  flush=True)
+    print(file=sys.stderr)
+    with open(os.path.join(args.out, "stability.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        writer.writeheader()
+        writer.writerows(rows)
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    colours = {"stable": "#2ca02c", "inverted": "#ff7f0e", "diverged": "#d62728",
+               "failed": "#7f7f7f"}
+    figure, axes = plt.subplots(len(MATERIALS), len(INTEGRATORS), figsize=(13, 7.5),
+                                sharex=True, sharey=True)
+    for i, material in enumerate(MATERIALS):
+        for j, integrator in enumerate(INTEGRATORS):
+            axis = axes[i][j]
+            panel = [r for r in rows if r["material"] == material and r["integrator"] == integrator]
+            for outcome, colour in colours.items():
+                points = [r for r in panel if r["outcome"] == outcome]
+                if points:
+                    axis.scatter([r["youngs_modulus"] for r in points], [r["dt"] for r in points],
+                                 s=120, marker="s", color=colour, label=outcome)
+            estimate = sorted((r["youngs_modulus"], r["stable_dt_estimate"]) for r in panel
+                              if r["stable_dt_estimate"])
+            estimate = sorted(dict(estimate).items())
+            if estimate and integrator != "implicit_euler":
+                axis.plot([e for e, _ in estimate], [d for _, d in estimate], "k--",
+                          label="stable-step estimate")
+            axis.set_xscale("log")
+            axis.set_yscale("log")
+            axis.set_title(f"{integrator}, {material}", fontsize=10)
+            axis.grid(True, which="both", alpha=0.3)
+            if i == len(MATERIALS) - 1:
+                axis.set_xlabel("Young's modulus E [Pa]")
+            if j == 0:
+                axis.set_ylabel("time step dt [s]")
+    handles = {}
+    for axis in axes.flat:
+        for handle, label in zip(*axis.get_legend_handles_labels()):
+            handles.setdefault(label, handle)
+    figure.legend(handles.values(), handles.keys(), loc="lower center", ncol=len(handles))
+    figure.suptitle("Stability map: cantilever under gravity, released from rest (0.3 s)")
+    figure.tight_layout(rect=(0, 0.06, 1, 0.96))
+    figure.savefig(os.path.join(args.out, "stability_map.png"), dpi=110)
+    plt.close(figure)
+    counts = {}
+    for r in rows:
+        counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
+    print(f"stability_map: {len(rows)} runs {counts}; wrote "
+          f"{os.path.join(args.out, 'stability_map.png')}")
+
+
+if __name__ == "__main__":
+    main()
