@@ -42,6 +42,8 @@ def main():
     by_run = {row["run"]: row for row in rows}
     if float(by_run["full"]["error"]) != 0.0:
         fail(f"the full run's error against itself is {by_run['full']['error']}")
+    if float(by_run["full"]["energy_difference"]) != 0.0 or by_run["uniform-0"]["energy_difference"] == "":
+        fail("energy differences missing or the full run's is not 0")
     adaptive = [row for row in rows if row["kind"] == "adaptive"]
     tightest = min(adaptive, key=lambda row: float(row["tolerance"]))
     if not float(by_run["uniform-0"]["error"]) > float(tightest["error"]):

@@ -17,7 +17,9 @@ Every run uses the scene's time stepping unchanged. Per run the sweep records wa
 (of the strata process), element evaluations, Newton and CG iterations, the largest active tets
 and DOFs, cut changes, redone steps, the run's own estimated error and the error against full
 resolution: the largest probe-displacement difference over every frame and probe, relative to the
-largest full-resolution probe displacement (what hierarchy.tolerance bounds). It writes
+largest full-resolution probe displacement (what hierarchy.tolerance bounds), and the difference of
+the final energies (elastic, kinetic, external potential; the largest, relative to the largest of
+the full run's). It writes
 OUT/NAME/results.csv, results.json and the charts error_vs_cost.png and adaptive_over_time.png.
 
 Resuming: each run lives in OUT/NAME/runs/<run>-<hash>/, the hash taken over the scene file's
@@ -223,6 +225,7 @@ def summarise(args, spec):
                 "redone_steps": hierarchy.get("redone_steps", 0),
                 "estimated_error": hierarchy.get("estimated_error"),
                 "tolerance_met": hierarchy.get("tolerance_met"),
+                "final_energies": stats.get("energies"),
                 "history": {k: history.get(k, []) for k in ("time", "tets", "dofs",
                                                              "estimated_error")},
             })
@@ -238,6 +241,14 @@ def summarise(args, spec):
         del row["probes"]
     full = next((r for r in rows if r["run"] == "full"), None)
     for row in rows:
+        # Final elastic, kinetic and external-potential energies against the full run's, relative
+        # to the full run's largest of the three.
+        if full is not None and full.get("final_energies") and row.get("final_energies"):
+            reference = full["final_energies"]
+            scale = max(abs(v) for v in reference.values())
+            if scale > 0.0:
+                row["energy_difference"] = max(abs(row["final_energies"].get(k, 0.0) - v)
+                                               for k, v in reference.items()) / scale
         if full is not None and row.get("wall_seconds"):
             row["speedup"] = full["wall_seconds"] / row["wall_seconds"]
         if row.get("error") and row.get("estimated_error") is not None and row["kind"] == "adaptive":
@@ -245,7 +256,8 @@ def summarise(args, spec):
     return rows
 
 
-COLUMNS = ["run", "kind", "level", "tolerance", "status", "error", "estimated_error",
+COLUMNS = ["run", "kind", "level", "tolerance", "status", "error", "energy_difference",
+           "estimated_error",
            "effectivity", "tolerance_met", "wall_seconds", "cpu_seconds", "speedup",
            "max_active_tets", "max_dofs", "element_evaluations", "newton_iterations",
            "linear_iterations", "linear_solver", "cut_changes", "redone_steps", "folder"]

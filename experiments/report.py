@@ -6,7 +6,8 @@
 Reads DIR/<name>/results.json of every sweep (default out/experiments, or only those of the given
 specs), copies each sweep's charts next to the report and writes OUT/REPORT.md (default
 experiments/results): the machine, the commands, per scene a table of every run (error against
-full resolution, the run's estimate and effectivity, wall time, speed-up, active DOFs), the charts,
+full resolution, the final-energy difference, the run's estimate and effectivity, wall time,
+speed-up, active DOFs), the charts,
 and the headline figures — the speed-up over full resolution at the default tolerance (0.01) and
 of the cheapest run within 1 % error — with a plain statement wherever a target is missed:
 adaptive at least 5× cheaper than full resolution at ≤ 1 % error on the local-load scenes, never
@@ -147,7 +148,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     lines = ["# strata experiments: cost against accuracy", "",
              f"Generated {datetime.date.today().isoformat()} by `experiments/report.py` from the "
-             f"sweeps of `experiments/experiment.py` (strata {version(args.strata)}, commit "
+             f"sweeps of `experiments/experiment.py` (strata {version(args.strata)}; report built at commit "
              f"{commit()}).", "", f"Machine: {machine()}. Times are wall times of one run each "
              "on a shared machine: compare them as ratios within one sweep.", "",
              "Error = the largest probe-displacement difference to the full-resolution run over "
@@ -200,15 +201,14 @@ def main():
         section = [f"## {name}", "", f"Scene: `{os.path.relpath(data['scene'], REPO)}`, "
                    f"{data['levels']} levels. Command: `/usr/bin/python3 experiments/experiment.py "
                    f"experiments/specs/{name}.json {overrides}`".rstrip() + "", "",
-                   "| run | error | estimated | effectivity | wall s | speed-up | largest DOFs | "
-                   "Newton its | CG its | cut changes | redone steps |",
-                   "|---|---|---|---|---|---|---|---|---|---|---|"]
+                   "| run | error | energy diff. | estimated | effectivity | wall s | speed-up | "
+                   "largest DOFs | Newton its | CG its | cut changes | redone steps |",
+                   "|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in runs:
-            section.append(
-                f"| {r['run']} | {percent(r.get('error'))} | {percent(r.get('estimated_error'))} "
-                f"| {r['effectivity']:.2f} | " if r.get("effectivity") is not None else
-                f"| {r['run']} | {percent(r.get('error'))} | {percent(r.get('estimated_error'))} "
-                f"| – | ")
+            effectivity = f"{r['effectivity']:.2f}" if r.get("effectivity") is not None else "–"
+            section.append(f"| {r['run']} | {percent(r.get('error'))} | "
+                           f"{percent(r.get('energy_difference'))} | "
+                           f"{percent(r.get('estimated_error'))} | {effectivity} | ")
             section[-1] += (f"{r['wall_seconds']:.2f} | {r.get('speedup', 0):.2f}× | "
                             f"{r.get('max_dofs', '–')} | {r.get('newton_iterations', '–')} | "
                             f"{r.get('linear_iterations', '–')} | {r.get('cut_changes', '–')} | "
