@@ -44,6 +44,8 @@ import threading
 import time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(REPO, "experiments", "hierarchy"))
+from compare_to_full import read_probes  # noqa: E402  (probes.csv keyed by (time, probe))
 
 
 def fail(message):
@@ -161,18 +163,6 @@ def execute(args, spec, name, settings, threads):
     return record
 
 
-def read_probes(folder):
-    frames = {}
-    path = os.path.join(folder, "probes.csv")
-    if not os.path.exists(path):
-        return frames
-    with open(path) as f:
-        for row in csv.DictReader(f):
-            key = (round(float(row["time"]), 12), int(row["probe"]))
-            frames[key] = (float(row["ux"]), float(row["uy"]), float(row["uz"]))
-    return frames
-
-
 def error_against(reference, frames):
     """(largest |Δu| over frames and probes / largest |u_ref|, per-time errors) or None."""
     scale = max((sum(c * c for c in u) ** 0.5 for u in reference.values()), default=0.0)
@@ -229,7 +219,8 @@ def summarise(args, spec):
                 "history": {k: history.get(k, []) for k in ("time", "tets", "dofs",
                                                              "estimated_error")},
             })
-        row["probes"] = read_probes(folder)
+        has_probes = os.path.exists(os.path.join(folder, "probes.csv"))
+        row["probes"] = read_probes(folder) if has_probes else {}
         if name == "full" and row["status"] == "ok":
             reference = row["probes"]
         rows.append(row)

@@ -15,6 +15,7 @@ slower than full resolution on the bending-dominated ones, and cheaper at equal 
 uniform level.
 """
 import argparse
+import csv
 import datetime
 import json
 import os
@@ -92,7 +93,6 @@ def dominated(runs):
 
 def stability_section(folder, out):
     """The stability map (stability_map.py) with a count of outcomes per panel."""
-    import csv
     source = os.path.join(folder, "stability_map.png")
     table = os.path.join(folder, "stability.csv")
     if not os.path.exists(source) or not os.path.exists(table):
@@ -148,8 +148,8 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     lines = ["# strata experiments: cost against accuracy", "",
              f"Generated {datetime.date.today().isoformat()} by `experiments/report.py` from the "
-             f"sweeps of `experiments/experiment.py` (strata {version(args.strata)}; report built at commit "
-             f"{commit()}).", "", f"Machine: {machine()}. Times are wall times of one run each "
+             f"sweeps of `experiments/experiment.py` (strata {version(args.strata)}; report "
+             f"built at commit {commit()}).", "", f"Machine: {machine()}. Times are wall times of one run each "
              "on a shared machine: compare them as ratios within one sweep.", "",
              "Error = the largest probe-displacement difference to the full-resolution run over "
              "every frame and probe, relative to the largest full-resolution probe displacement "

@@ -40,16 +40,17 @@ Material material(double poisson_ratio) {
   return m;
 }
 
-struct SolveResult {
-  VectorXd direct;
-  VectorXd multigrid;
-  long iterations = 0;
-  int levels = 0;
+/// K u = f on a cut, clamped at x = 0, f a smooth body load, reduced to the free DOFs; with the
+/// cut's nested spaces.
+struct ClampedSystem {
+  SparseMatrixd A;
+  VectorXd b;
+  NestedSpaces spaces;
+  std::vector<Index> free_dofs;
   Index hanging = 0;
 };
 
-/// K u = f on the cut, clamped at x = 0, f a smooth body load; CHOLMOD against multigrid-PCG.
-SolveResult solve_both(const ActiveCut& cut, double poisson_ratio) {
+ClampedSystem clamped_system(const ActiveCut& cut, double poisson_ratio) {
   const ConstrainedCut c = flatten_cut(cut);
   const ElasticModel model(c.flat.mesh.vertices, c.flat.mesh.tets, material(poisson_ratio));
   const EmbeddedElasticModel embedded(model, c.constraints.matrix(), c.constraints.free_vertices());
@@ -64,19 +65,34 @@ SolveResult solve_both(const ActiveCut& cut, double poisson_ratio) {
     f.segment<3>(3 * q) = Vector3d(std::sin(3 * X.y()), 0.2, -1.0 - X.x() * X.z());
   }
   const DofReduction reduction(embedded.stiffness_pattern(), constrained);
-  SparseMatrixd A;
-  reduction.restrict_matrix(K, A);
-  const VectorXd b = reduction.restrict_vector(f);
+  ClampedSystem system;
+  reduction.restrict_matrix(K, system.A);
+  system.b = reduction.restrict_vector(f);
+  system.spaces = cut_nested_spaces(cut.tree(), c);
+  system.free_dofs = reduction.free_dofs();
+  system.hanging = c.constraints.num_hanging();
+  return system;
+}
 
-  const NestedSpaces spaces = cut_nested_spaces(cut.tree(), c);
+struct SolveResult {
+  VectorXd direct;
+  VectorXd multigrid;
+  long iterations = 0;
+  int levels = 0;
+  Index hanging = 0;
+};
+
+/// The clamped system of the cut by CHOLMOD and by multigrid-PCG (which must not fall back).
+SolveResult solve_both(const ActiveCut& cut, double poisson_ratio) {
+  const ClampedSystem system = clamped_system(cut, poisson_ratio);
   SolveResult result;
-  result.hanging = c.constraints.num_hanging();
+  result.hanging = system.hanging;
   SpdSolver direct(LinearSolverKind::cholmod);
-  EXPECT_TRUE(direct.solve(A, b, result.direct));
+  EXPECT_TRUE(direct.solve(system.A, system.b, result.direct));
   SpdSolver multigrid(LinearSolverKind::multigrid);
-  multigrid.use_nested_spaces(&spaces, reduction.free_dofs());
+  multigrid.use_nested_spaces(&system.spaces, system.free_dofs);
   EXPECT_EQ(multigrid.kind(), LinearSolverKind::multigrid);
-  EXPECT_TRUE(multigrid.solve(A, b, result.multigrid));
+  EXPECT_TRUE(multigrid.solve(system.A, system.b, result.multigrid));
   EXPECT_EQ(multigrid.direct_fallbacks(), 0);  // solved by multigrid, not by CHOLMOD
   EXPECT_EQ(multigrid.kind(), LinearSolverKind::multigrid);
   result.iterations = multigrid.cg_iterations();
@@ -160,21 +176,11 @@ TEST(CutMultigrid, ThinPlate) {
 // A system multigrid-PCG does not solve within its iteration limit is solved by CHOLMOD.
 TEST(CutMultigrid, FallsBackToCholmod) {
   TetTree tree(beam(), 2);
-  const ConstrainedCut c = flatten_cut(ActiveCut::uniform(tree, 2));
-  const ElasticModel model(c.flat.mesh.vertices, c.flat.mesh.tets, material(0.3));
-  SparseMatrixd K;
-  model.stiffness(model.rest_positions(), K, false);
-  std::vector<char> constrained(model.num_dofs(), 0);
-  for (Index v = 0; v < model.num_vertices(); ++v)
-    if (c.flat.mesh.vertices(v, 0) == 0.0)
-      constrained[3 * v] = constrained[3 * v + 1] = constrained[3 * v + 2] = 1;
-  const DofReduction reduction(model.stiffness_pattern(), constrained);
-  SparseMatrixd A;
-  reduction.restrict_matrix(K, A);
-  const VectorXd b = VectorXd::LinSpaced(A.rows(), -1.0, 1.0);
-  const NestedSpaces spaces = cut_nested_spaces(tree, c);
+  const ClampedSystem system = clamped_system(ActiveCut::uniform(tree, 2), 0.3);
+  const SparseMatrixd& A = system.A;
+  const VectorXd& b = system.b;
   SpdSolver solver(LinearSolverKind::multigrid);
-  solver.use_nested_spaces(&spaces, reduction.free_dofs());
+  solver.use_nested_spaces(&system.spaces, system.free_dofs);
   solver.set_max_iterations(2);
   VectorXd x;
   ASSERT_TRUE(solver.solve(A, b, x));
@@ -189,21 +195,11 @@ TEST(CutMultigrid, FallsBackToCholmod) {
 // nearby matrix reuses the hierarchy (no new setup); the solutions are the direct ones.
 TEST(CutMultigrid, RefusesIndefiniteAndReusesTheHierarchy) {
   TetTree tree(beam(), 2);
-  const ConstrainedCut c = flatten_cut(ActiveCut::uniform(tree, 2));
-  const ElasticModel model(c.flat.mesh.vertices, c.flat.mesh.tets, material(0.3));
-  SparseMatrixd K;
-  model.stiffness(model.rest_positions(), K, false);
-  std::vector<char> constrained(model.num_dofs(), 0);
-  for (Index v = 0; v < model.num_vertices(); ++v)
-    if (c.flat.mesh.vertices(v, 0) == 0.0)
-      constrained[3 * v] = constrained[3 * v + 1] = constrained[3 * v + 2] = 1;
-  const DofReduction reduction(model.stiffness_pattern(), constrained);
-  SparseMatrixd A;
-  reduction.restrict_matrix(K, A);
-  const VectorXd b = VectorXd::LinSpaced(A.rows(), -1.0, 1.0);
-  const NestedSpaces spaces = cut_nested_spaces(tree, c);
+  const ClampedSystem system = clamped_system(ActiveCut::uniform(tree, 2), 0.3);
+  const SparseMatrixd& A = system.A;
+  const VectorXd& b = system.b;
   SpdSolver solver(LinearSolverKind::multigrid);
-  solver.use_nested_spaces(&spaces, reduction.free_dofs());
+  solver.use_nested_spaces(&system.spaces, system.free_dofs);
   VectorXd x;
   ASSERT_TRUE(solver.solve(A, b, x));
   EXPECT_EQ(solver.multigrid_setups(), 1);
