@@ -77,6 +77,9 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.increment_converged_steps += b.increment_converged_steps;
   a.stalled_steps += b.stalled_steps;
   a.max_residual_ratio = std::max(a.max_residual_ratio, b.max_residual_ratio);
+  a.plastic_passes += b.plastic_passes;
+  a.plastic_unconverged_steps += b.plastic_unconverged_steps;
+  a.yielded_tets = b.yielded_tets;
   return a;
 }
 
@@ -154,7 +157,16 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   m_controller->set_coarsening_veto([this](NodeId parent) {
     return dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
   });
-  m_point_loads = finest_level_loads(*m_tree, loads, m_tolerance);
+  std::vector<RegionLoad> constant_loads;
+  for (const RegionLoad& load : loads) {
+    if (load.amplitude.empty()) {
+      constant_loads.push_back(load);
+      continue;
+    }
+    validate_amplitude(load.amplitude, load.name + ".amplitude");
+    m_timed_point_loads.emplace_back(load.amplitude, finest_level_loads(*m_tree, {load}, m_tolerance));
+  }
+  m_point_loads = finest_level_loads(*m_tree, constant_loads, m_tolerance);
   make_dirichlet_exact();
   rebuild(0);
   m_bookkeeping_seconds += seconds_since(start);
@@ -267,6 +279,14 @@ void AdaptiveSimulation::rebuild(long first_step) {
   options.first_step = first_step;
   options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
   m_mesh_external = options.extra_mesh_forces;
+  // The criteria see every load at its peak.
+  for (const auto& [amplitude, point_loads] : m_timed_point_loads) {
+    VectorXd traction;
+    VectorXd forces = map_point_loads(*m_cut, flat, point_loads, &traction);
+    m_load_traction = m_load_traction.cwiseMax(amplitude.peak() * traction);
+    m_mesh_external += amplitude.peak() * forces;
+    options.extra_timed_mesh_forces.push_back({amplitude, std::move(forces)});
+  }
   m_simulation =
       std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet, std::vector<RegionLoad>{},
                                    m_ground, m_gravity, m_solver, std::move(options));
@@ -306,6 +326,7 @@ void AdaptiveSimulation::advance_with_redo() {
   VectorXd v0 = m_simulation->velocities();
   double kinetic0 = m_simulation->kinetic_energy();
   Vector3d momentum0 = momentum(*m_simulation);
+  PlasticState plastic0 = m_simulation->plastic_state();
   auto step_start = Clock::now();
   m_estimate_valid = false;
   m_simulation->advance();
@@ -318,11 +339,12 @@ void AdaptiveSimulation::advance_with_redo() {
     m_report.redo_seconds += attempt;
     // The Simulation is one step ahead: carry the start-of-step state to the new cut and redo
     // the step there (the new cut's start state is the one a further pass starts from).
-    change_cut(changes, pass, step_count() - 1, x0, v0, kinetic0, momentum0);
+    change_cut(changes, pass, step_count() - 1, x0, v0, kinetic0, momentum0, plastic0);
     x0 = m_simulation->positions();
     v0 = m_simulation->velocities();
     kinetic0 = m_simulation->kinetic_energy();
     momentum0 = momentum(*m_simulation);
+    plastic0 = m_simulation->plastic_state();
     step_start = Clock::now();
     m_estimate_valid = false;
     m_simulation->advance();
@@ -367,13 +389,14 @@ bool AdaptiveSimulation::adapt(int pass, bool refine, bool coarsen) {
   const VectorXd x = m_simulation->positions();
   const VectorXd v = m_simulation->velocities();
   change_cut(changes, pass, step_count(), x, v, m_simulation->kinetic_energy(),
-             momentum(*m_simulation));
+             momentum(*m_simulation), m_simulation->plastic_state());
   return true;
 }
 
 void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long first_step,
                                     const VectorXd& x_mesh, const VectorXd& v_mesh,
-                                    double old_kinetic_energy, const Vector3d& old_momentum) {
+                                    double old_kinetic_energy, const Vector3d& old_momentum,
+                                    const PlasticState& plastic) {
   const auto start = Clock::now();
   const Simulation& sim = *m_simulation;
   CutChangeRecord record;
@@ -403,6 +426,10 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     const HangingConstraints& constraints = m_constrained->constraints;
     const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
     const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
+    if (!plastic.empty())
+      m_simulation->set_plastic_state(transfer_plastic_state(*m_tree, old_cut->flat, plastic,
+                                                             new_flat,
+                                                             &record.plastic_merge_change));
     m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
     keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_simulation->dof_vertex_mass(),
                         old_kinetic_energy, old_momentum);

@@ -83,17 +83,27 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
   m_partition = build_tet_partition(rest_positions, tets);
   const Index num_tets = tets.rows();
   m_sorted_tets.resize(4 * num_tets);
+  for (Index i = 0; i < num_tets; ++i)
+    for (int k = 0; k < 4; ++k)
+      m_sorted_tets[4 * i + k] = tets(m_partition.order[i], k);
+  fill_rest_arrays();
+  build_stiffness_pattern();
+}
+
+void ElasticModel::fill_rest_arrays() {
+  const Index num_tets = m_tets.rows();
   m_sorted_Dm_inv.resize(9 * num_tets);
   m_sorted_volume.resize(num_tets);
   m_sorted_Dm_inv_det.resize(num_tets);
   for (Index i = 0; i < num_tets; ++i) {
     const int t = m_partition.order[i];
-    for (int k = 0; k < 4; ++k)
-      m_sorted_tets[4 * i + k] = tets(t, k);
     Eigen::Map<Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
-    Dm_inv = m_rest.Dm_inv[t];
+    if (m_plastic_inverse.empty())
+      Dm_inv = m_rest.Dm_inv[t];
+    else
+      Dm_inv = m_rest.Dm_inv[t] * m_plastic_inverse[t];
     m_sorted_volume[i] = m_rest.rest_volume[t];
-    m_sorted_Dm_inv_det[i] = m_rest.Dm_inv[t].determinant();
+    m_sorted_Dm_inv_det[i] = Dm_inv.determinant();
   }
   // Rest data regrouped for the vectorised kernels, one contiguous block per lane group g: entry
   // (j, c) of Dm⁻¹ of its kLanes tets at [g · kLaneRest + (3c + j) · kLanes + lane], then the rest
@@ -107,7 +117,14 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
       group[entry * detail::kLanes + i % detail::kLanes] = m_sorted_Dm_inv[9 * i + entry];
     group[9 * detail::kLanes + i % detail::kLanes] = m_sorted_volume[i];
   }
-  build_stiffness_pattern();
+}
+
+void ElasticModel::set_plastic_inverse(const std::vector<Matrix3d>& plastic_inverse) {
+  if (!plastic_inverse.empty() && static_cast<Index>(plastic_inverse.size()) != num_tets())
+    throw std::invalid_argument("ElasticModel::set_plastic_inverse: expected " +
+                                std::to_string(num_tets()) + " matrices");
+  m_plastic_inverse = plastic_inverse;
+  fill_rest_arrays();
 }
 
 namespace {
@@ -454,7 +471,8 @@ TetFields ElasticModel::tet_fields(ConstRef<VectorXd> x) const {
   tbb::parallel_for(Index(0), num_tets(), [&](Index t) {
     int tet[4] = {m_tets(t, 0), m_tets(t, 1), m_tets(t, 2), m_tets(t, 3)};
     const Matrix3d F = edge_matrix_at(x.data(), tet) * m_rest.Dm_inv[t];
-    const Matrix3d sigma = cauchy_stress(dpsi_dF(m_material.model, F, m_lame), F);
+    const Matrix3d Fe = m_plastic_inverse.empty() ? F : Matrix3d(F * m_plastic_inverse[t]);
+    const Matrix3d sigma = cauchy_stress(dpsi_dF(m_material.model, Fe, m_lame), Fe);
     fields.green_strain.row(t) = to_voigt(green_strain(F)).transpose();
     fields.cauchy_stress.row(t) = to_voigt(sigma).transpose();
     fields.von_mises[t] = von_mises_stress(sigma);

@@ -51,6 +51,7 @@ void validate_material(const Material& material, const std::string& where) {
     throw InputError(where + ".damping.mass: must be >= 0");
   if (!(material.stiffness_damping >= 0.0) || !std::isfinite(material.stiffness_damping))
     throw InputError(where + ".damping.stiffness: must be >= 0");
+  if (material.plasticity) validate_plasticity(*material.plasticity, where + ".plasticity");
 }
 
 }  // namespace strata

@@ -7,6 +7,14 @@
 
 namespace strata {
 
+double DirichletGroup::factor(double t, double default_s) const {
+  return spec.amplitude.empty() ? default_s : spec.amplitude.value(t);
+}
+
+double DirichletGroup::factor_rate(double t, double default_rate) const {
+  return spec.amplitude.empty() ? default_rate : spec.amplitude.rate(t);
+}
+
 Vector3d DirichletGroup::target_position(const Vector3d& X, double s) const {
   switch (spec.kind) {
     case DirichletKind::fixed:
@@ -50,6 +58,7 @@ std::vector<DirichletGroup> resolve_dirichlet_groups(const std::vector<Dirichlet
   for (size_t g = 0; g < specs.size(); ++g) {
     const DirichletSpec& spec = specs[g];
     validate_region(spec.region, spec.name + ".region");
+    validate_amplitude(spec.amplitude, spec.name + ".amplitude");
     if (spec.kind == DirichletKind::rotation &&
         (!spec.axis.allFinite() || spec.axis.norm() == 0.0 || !std::isfinite(spec.angle)))
       throw InputError(spec.name + ": rotation needs a finite non-zero axis and a finite angle");
@@ -101,9 +110,11 @@ std::vector<char> dirichlet_dof_mask(const std::vector<DirichletGroup>& groups,
   return mask;
 }
 
-void apply_dirichlet(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest, double s,
-                     double ds_dt, VectorXd& x, VectorXd& v) {
+void apply_dirichlet(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest, double t,
+                     double default_s, double default_rate, VectorXd& x, VectorXd& v) {
   for (const DirichletGroup& group : groups) {
+    const double s = group.factor(t, default_s);
+    const double ds_dt = group.factor_rate(t, default_rate);
     for (int vertex : group.vertices) {
       const Vector3d X = rest.segment<3>(3 * vertex);
       const Vector3d target_x = group.target_position(X, s);

@@ -13,7 +13,10 @@ void symplectic_euler_step(const Problem& system, double t, double h, VectorXd& 
     VectorXd local;
     VectorXd& f = scratch != nullptr ? scratch->forces : local;
     system.model.forces(x, f);
-    const double* f_ext = system.external_forces.data();
+    VectorXd timed_external;
+    if (system.has_timed_forces()) system.external_forces_at(t, 1.0, timed_external);
+    const double* f_ext =
+        system.has_timed_forces() ? timed_external.data() : system.external_forces.data();
     const double* mass = system.dof_mass.data();
     double* xs = x.data();
     double* vs = v.data();

@@ -15,7 +15,7 @@ ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
   m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_inertia = &m_energy.emplace<InertiaTerm>(problem.dof_mass);
   m_energy.emplace<ElasticTerm>(problem.model);
-  m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
+  m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.mass_damping > 0.0 || problem.stiffness_damping > 0.0)
     m_damping = &m_energy.emplace<RayleighDampingTerm>(
         problem.model, problem.dof_mass, problem.mass_damping, problem.stiffness_damping);
@@ -30,6 +30,12 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
   m_inertia->set_step(x_tilde, h);
   if (m_damping != nullptr) m_damping->set_step(x_start, h);
 
+  if (sys.has_timed_forces()) {
+    sys.external_forces_at(t + h, 1.0, m_timed_external);
+    m_external->set_forces(m_timed_external);
+  }
+  const VectorXd& f_ext = sys.has_timed_forces() ? m_timed_external : sys.external_forces;
+
   VectorXd y = x_tilde;
   VectorXd v_end = v;
   sys.apply_constraints(t + h, y, v_end);
@@ -41,13 +47,13 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
   settings.tolerance = m_controls.tolerance;
   settings.exact_hessian = m_controls.exact_hessian;
   settings.force_scale = M.cwiseProduct(y - x_tilde).norm() / (h * h) + f_int.norm() +
-                         sys.external_forces.norm() + M.cwiseProduct(v).norm() / h;
+                         f_ext.norm() + M.cwiseProduct(v).norm() / h;
   settings.step_tolerance = 1e-13 * sys.diagonal;
   settings.residual_floor = internal_force_roundoff(model);
   settings.rest_positions = &model.rest_positions();
   const LameParameters lame = model.material().lame();
   settings.energy_scale = (2 * lame.mu + lame.lambda) * model.total_rest_volume() +
-                          std::abs(sys.external_forces.dot(y)) +
+                          std::abs(f_ext.dot(y)) +
                           0.5 / (h * h) * (y - x_tilde).dot(M.cwiseProduct(y - x_tilde));
 
   const NewtonResult result = newton_minimize(m_energy, m_reduction, m_solver, settings, y);

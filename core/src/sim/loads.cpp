@@ -48,18 +48,35 @@ void add_region_force(const std::string& name, const std::vector<int>& vertices,
   }
 }
 
-VectorXd external_forces(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX3i> boundary,
-                         ConstRef<VectorXd> vertex_mass, const Vector3d& gravity,
-                         const std::vector<RegionLoad>& loads, double tolerance) {
+ExternalLoads external_loads(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX3i> boundary,
+                             ConstRef<VectorXd> vertex_mass, const Vector3d& gravity,
+                             const std::vector<RegionLoad>& loads, double tolerance) {
   if (!gravity.allFinite()) throw InputError("gravity: must be finite");
-  VectorXd forces = gravity_forces(vertex_mass, gravity);
+  ExternalLoads result;
+  result.base = gravity_forces(vertex_mass, gravity);
   for (const RegionLoad& load : loads) {
     validate_region(load.region, load.name + ".region");
     if (!load.total_force.allFinite()) throw InputError(load.name + ": total_force must be finite");
+    validate_amplitude(load.amplitude, load.name + ".amplitude");
+    VectorXd* target = &result.base;
+    if (!load.amplitude.empty()) {
+      result.timed.push_back({load.amplitude, VectorXd::Zero(result.base.size())});
+      target = &result.timed.back().forces;
+    }
     add_region_force(load.name, select_vertices(load.region, rest_positions, tolerance),
-                     load.total_force, rest_positions, boundary, forces);
+                     load.total_force, rest_positions, boundary, *target);
   }
-  return forces;
+  return result;
+}
+
+VectorXd external_forces(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX3i> boundary,
+                         ConstRef<VectorXd> vertex_mass, const Vector3d& gravity,
+                         const std::vector<RegionLoad>& loads, double tolerance) {
+  ExternalLoads split =
+      external_loads(rest_positions, boundary, vertex_mass, gravity, loads, tolerance);
+  for (const TimedForces& timed : split.timed)
+    split.base += timed.forces;
+  return split.base;
 }
 
 }  // namespace strata

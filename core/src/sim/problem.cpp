@@ -12,8 +12,15 @@ double Problem::ramp_rate(double t) const {
   return t < ramp_time ? 1.0 / ramp_time : 0.0;
 }
 
+void Problem::external_forces_at(double t, double base_scale, VectorXd& f) const {
+  f = base_scale * external_forces;
+  if (timed_forces == nullptr) return;
+  for (const TimedForces& timed : *timed_forces)
+    f += timed.amplitude.value(t) * timed.forces;
+}
+
 void Problem::apply_constraints(double t, VectorXd& x, VectorXd& v) const {
-  apply_dirichlet(groups, model.rest_positions(), ramp(t), ramp_rate(t), x, v);
+  apply_dirichlet(groups, model.rest_positions(), t, ramp(t), ramp_rate(t), x, v);
 }
 
 void Problem::add_damping_forces(const VectorXd& x, const VectorXd& v, const VectorXd& f_int,
@@ -33,13 +40,20 @@ void Problem::add_damping_forces(const VectorXd& x, const VectorXd& v, const Vec
 void Problem::accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const {
   VectorXd f_int;
   model.forces(x, f_int);
-  VectorXd f = f_int + external_forces;
+  VectorXd f = f_int;
+  if (has_timed_forces()) {
+    VectorXd f_ext;
+    external_forces_at(t, 1.0, f_ext);
+    f += f_ext;
+  } else {
+    f += external_forces;
+  }
   add_damping_forces(x, v, f_int, f);
   a = f.array() / dof_mass.array();
-  const double s = ramp(t);
-  const double ds_dt = ramp_rate(t);
   const VectorXd& rest = model.rest_positions();
   for (const DirichletGroup& group : groups) {
+    const double s = group.factor(t, ramp(t));
+    const double ds_dt = group.factor_rate(t, ramp_rate(t));
     for (int vertex : group.vertices) {
       const Vector3d target = group.target_acceleration(rest.segment<3>(3 * vertex), s, ds_dt);
       for (int c = 0; c < 3; ++c)

@@ -67,8 +67,9 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   const MatrixX3d dof_rest = unflatten(m_embedded->rest_positions());
   m_groups = resolve_dirichlet_groups(dirichlet, dof_rest, tolerance);
   m_constrained = dirichlet_dof_mask(m_groups, num_dof_vertices);
-  VectorXd mesh_external = strata::external_forces(m_mesh.vertices, m_boundary, m_vertex_mass,
-                                                   gravity, loads, tolerance);
+  ExternalLoads mesh_loads =
+      external_loads(m_mesh.vertices, m_boundary, m_vertex_mass, gravity, loads, tolerance);
+  VectorXd& mesh_external = mesh_loads.base;
   if (options.extra_mesh_forces.size() > 0) {
     if (options.extra_mesh_forces.size() != mesh_external.size() ||
         !options.extra_mesh_forces.allFinite())
@@ -76,6 +77,16 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     mesh_external += options.extra_mesh_forces;
   }
   m_external = m_embedded->reduce(mesh_external);
+  for (TimedForces& timed : options.extra_timed_mesh_forces) {
+    validate_amplitude(timed.amplitude, "simulation: extra_timed_mesh_forces");
+    if (timed.amplitude.empty() || timed.forces.size() != mesh_external.size() ||
+        !timed.forces.allFinite())
+      throw InputError(
+          "simulation: extra_timed_mesh_forces need an amplitude and 3·#V finite values");
+    mesh_loads.timed.push_back(std::move(timed));
+  }
+  for (const TimedForces& timed : mesh_loads.timed)
+    m_timed.push_back({timed.amplitude, m_embedded->reduce(timed.forces)});
   m_stable_dt =
       stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
   m_limits = default_divergence_limits(m_material, m_diagonal);
@@ -93,6 +104,12 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     options.nested_spaces.check();
     m_nested = std::move(options.nested_spaces);
   }
+  if (m_material.plasticity) {
+    m_plastic = PlasticState::identity(m_mesh.tets.rows());
+    if (!options.plastic_state.empty()) set_plastic_state(std::move(options.plastic_state));
+  } else if (!options.plastic_state.empty()) {
+    throw InputError("simulation: plastic_state given for a material without plasticity");
+  }
   m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
@@ -107,10 +124,11 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .diagonal = m_diagonal,
                              .ground = m_ground ? &*m_ground : nullptr,
                              .ground_stiffness = m_ground_stiffness,
-                             .nested_spaces = m_nested.empty() ? nullptr : &m_nested});
+                             .nested_spaces = m_nested.empty() ? nullptr : &m_nested,
+                             .timed_forces = &m_timed});
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
   if (is_static()) {
-    if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), 0.0, m_x, m_v);
+    if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), load_factor(), 0.0, m_x, m_v);
     m_v.setZero();
   } else {
     m_system->apply_constraints(time(), m_x, m_v);
@@ -140,7 +158,9 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
   m_v = is_static() ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
   m_stepper->reset_history();
   if (is_static()) {
-    apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), 0.0, m_x, m_v);
+    apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), load_factor(), 0.0,
+                    m_x, m_v);
+    m_v.setZero();
   } else {
     m_system->apply_constraints(time(), m_x, m_v);
   }
@@ -168,15 +188,72 @@ void Simulation::advance() {
   const double t1 = is_static() ? static_cast<double>(m_steps + 1) / m_settings.load_steps
                                 : static_cast<double>(m_steps + 1) * m_settings.dt;
   const double h = is_static() ? t1 - t0 : m_settings.dt;
+  VectorXd q_start, v_start;
+  if (is_plastic() && !m_stepper_traits->is_explicit) {
+    q_start = m_x;
+    v_start = m_v;
+  }
   const NewtonResult result = m_stepper->step(t0, t1, h, m_x, m_v);
   record_newton(result);
   if (!result.converged)
     throw_newton_failure(std::string(m_stepper_traits->name), result.iterations, result.residual);
   if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
-  ++m_steps;
   update_mesh_state();
+  if (is_plastic()) update_plastic_state(t0, t1, h, q_start, v_start);
+  ++m_steps;
   check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
                    m_steps, time(), std::string(m_stepper_traits->name));
+}
+
+void Simulation::set_plastic_state(PlasticState state) {
+  if (!is_plastic()) throw InputError("simulation: plastic state for a material without plasticity");
+  if (state.num_tets() != m_mesh.tets.rows() ||
+      static_cast<Index>(state.plastic_inverse.size()) != m_mesh.tets.rows())
+    throw InputError("simulation: plastic state must hold " + std::to_string(m_mesh.tets.rows()) +
+                     " tets");
+  m_plastic = std::move(state);
+  m_model->set_plastic_inverse(m_plastic.plastic_inverse);
+}
+
+void Simulation::update_plastic_state(double t0, double t1, double h, const VectorXd& q_start,
+                                      const VectorXd& v_start) {
+  const Plasticity& plasticity = *m_material.plasticity;
+  const PlasticState start = m_plastic;
+  const double tolerance =
+      m_settings.plastic_tolerance * plasticity.yield_stress / m_material.youngs_modulus;
+  for (int pass = 1;; ++pass) {
+    Index yielded = 0;
+    PlasticState next = return_map(*m_model, positions(), start, plasticity, &yielded);
+    const double change =
+        next.num_tets() == 0
+            ? 0.0
+            : (next.equivalent_strain - m_plastic.equivalent_strain).cwiseAbs().maxCoeff();
+    m_plastic = std::move(next);
+    m_model->set_plastic_inverse(m_plastic.plastic_inverse);
+    ++m_newton.plastic_passes;
+    m_newton.yielded_tets = yielded;
+    if (m_stepper_traits->is_explicit || change <= tolerance) return;
+    if (pass >= m_settings.max_plastic_passes) {
+      ++m_newton.plastic_unconverged_steps;
+      return;
+    }
+    // The step again, with the plastic state of this pass.
+    NewtonResult result;
+    if (is_static()) {
+      result = m_stepper->resolve(t1, m_x, m_v);
+    } else {
+      m_x = q_start;
+      m_v = v_start;
+      result = m_stepper->step(t0, t1, h, m_x, m_v);
+    }
+    record_newton(result);
+    if (!result.converged)
+      throw_newton_failure(std::string(m_stepper_traits->name) + " (plastic pass " +
+                               std::to_string(pass + 1) + ")",
+                           result.iterations, result.residual);
+    if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
+    update_mesh_state();
+  }
 }
 
 void Simulation::throw_newton_failure(const std::string& context, int iterations,
@@ -205,6 +282,8 @@ void Simulation::resolve_static() {
                               " N)",
                           m_steps, lambda);
   update_mesh_state();
+  // Plastic flow from the carried state, with further passes until it settles.
+  if (is_plastic()) update_plastic_state(lambda, lambda, 0.0, m_x, m_v);
   check_divergence(*m_model, positions(), VectorXd(), m_limits, m_steps, lambda, "static");
 }
 
@@ -214,14 +293,14 @@ std::vector<GroupReaction> Simulation::reactions() const {
   VectorXd f = f_int;
   VectorXd mass_times_acceleration = VectorXd::Zero(m_x.size());
   if (is_static()) {
-    f += load_factor() * m_external;
+    f += current_external_forces();
     if (m_ground) {
       VectorXd penalty_gradient = VectorXd::Zero(m_x.size());
       add_ground_penalty_gradient(*m_ground, m_ground_stiffness, m_x, penalty_gradient);
       f -= penalty_gradient;
     }
   } else {
-    f += m_external;
+    f += current_external_forces();
     m_system->add_damping_forces(m_x, m_v, f_int, f);
     m_system->accelerations(time(), m_x, m_v, mass_times_acceleration);
     mass_times_acceleration.array() *= m_dof_mass.array();
@@ -252,8 +331,20 @@ double Simulation::elastic_energy() const {
 }
 
 double Simulation::external_potential_energy() const {
-  const double scale = is_static() ? load_factor() : 1.0;
-  return -scale * m_external.dot(m_x - m_embedded->rest_positions());
+  if (m_timed.empty()) {
+    const double scale = is_static() ? load_factor() : 1.0;
+    return -scale * m_external.dot(m_x - m_embedded->rest_positions());
+  }
+  return -current_external_forces().dot(m_x - m_embedded->rest_positions());
+}
+
+VectorXd Simulation::current_external_forces() const {
+  VectorXd f;
+  if (is_static())
+    m_system->external_forces_at(load_factor(), load_factor(), f);
+  else
+    m_system->external_forces_at(time(), 1.0, f);
+  return f;
 }
 
 void Simulation::record_newton(const NewtonResult& result) {

@@ -67,10 +67,12 @@ void validate_solver_settings(const SolverSettings& s, const std::string& where)
   positive(s.duration, "duration");
   positive(s.newton_tolerance, "newton_tolerance");
   positive(s.contact_stiffness_factor, "contact_stiffness_factor");
+  positive(s.plastic_tolerance, "plastic_tolerance");
   if (!std::isfinite(s.ramp_time) || s.ramp_time < 0.0)
     throw InputError(where + ".ramp_time: must be a finite number >= 0");
   if (s.load_steps < 1) throw InputError(where + ".load_steps: must be >= 1");
   if (s.max_newton_iterations < 1) throw InputError(where + ".max_newton_iterations: must be >= 1");
+  if (s.max_plastic_passes < 1) throw InputError(where + ".max_plastic_passes: must be >= 1");
 }
 
 }  // namespace strata

@@ -24,18 +24,27 @@ NewtonResult StaticSolver::solve(double load_factor, VectorXd& q) {
   const double lambda = load_factor;
   const EmbeddedElasticModel& model = m_problem.model;
   m_external->set_load_factor(lambda);
+  if (m_problem.has_timed_forces()) {
+    m_problem.external_forces_at(lambda, lambda, m_timed_external);
+    m_external->set_forces(m_timed_external);
+    m_external->set_load_factor(1.0);
+  }
 
   VectorXd unused_velocity = VectorXd::Zero(q.size());
-  apply_dirichlet(m_problem.groups, model.rest_positions(), lambda, 0.0, q, unused_velocity);
+  apply_dirichlet(m_problem.groups, model.rest_positions(), lambda, lambda, 0.0, q,
+                  unused_velocity);
 
   VectorXd f_int;
   model.forces(q, f_int);
-  const VectorXd& f_ext = m_problem.external_forces;
+  // The external forces at λ are s_f · f_ext.
+  const bool timed = m_problem.has_timed_forces();
+  const VectorXd& f_ext = timed ? m_timed_external : m_problem.external_forces;
+  const double s_f = timed ? 1.0 : lambda;
   NewtonSettings settings;
   settings.max_iterations = m_controls.max_iterations;
   settings.tolerance = m_controls.tolerance;
   settings.exact_hessian = m_controls.exact_hessian;
-  settings.force_scale = std::max((lambda * f_ext).norm(), f_int.norm());
+  settings.force_scale = std::max((s_f * f_ext).norm(), f_int.norm());
   settings.residual_floor = internal_force_roundoff(model);
   const VectorXd& rest = model.rest_positions();
   const double size =
@@ -44,7 +53,7 @@ NewtonResult StaticSolver::solve(double load_factor, VectorXd& q) {
   settings.rest_positions = &rest;
   const LameParameters lame = model.material().lame();
   settings.energy_scale =
-      (2 * lame.mu + lame.lambda) * model.total_rest_volume() + std::abs(lambda * f_ext.dot(q));
+      (2 * lame.mu + lame.lambda) * model.total_rest_volume() + std::abs(s_f * f_ext.dot(q));
   return newton_minimize(m_energy, m_reduction, m_solver, settings, q);
 }
 

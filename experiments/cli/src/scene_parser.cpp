@@ -43,6 +43,22 @@ Region parse_region(const SceneValue& value) {
   return SphereRegion{sphere.at("center").vec3(), sphere.at("radius").non_negative()};
 }
 
+/// `[[t, s], ...]`: at least one point, t strictly increasing.
+Amplitude parse_amplitude(const SceneValue& value) {
+  Amplitude amplitude;
+  for (const SceneValue& point : value.elements()) {
+    const std::vector<SceneValue> pair = point.elements();
+    if (pair.size() != 2) point.fail("must be a pair [t, s]");
+    const double t = pair[0].number();
+    if (!amplitude.points.empty() && !(t > amplitude.points.back()[0])) {
+      pair[0].fail("times must increase strictly");
+    }
+    amplitude.points.push_back({t, pair[1].number()});
+  }
+  if (amplitude.points.empty()) value.fail("must hold at least one point [t, s]");
+  return amplitude;
+}
+
 std::filesystem::path parse_path(const SceneValue& value, const std::filesystem::path& folder) {
   const std::string name = value.string();
   if (name.empty()) value.fail("must not be empty");
@@ -128,8 +144,20 @@ MeshSpec parse_mesh(const SceneValue& value, const std::filesystem::path& folder
   return mesh;
 }
 
+Plasticity parse_plasticity(const SceneValue& value) {
+  value.expect_object({"yield_stress", "hardening", "max_plastic_strain"});
+  Plasticity plasticity;
+  plasticity.yield_stress = value.at("yield_stress").positive();
+  if (value.has("hardening")) plasticity.hardening = value.at("hardening").non_negative();
+  if (value.has("max_plastic_strain")) {
+    plasticity.max_plastic_strain = value.at("max_plastic_strain").positive();
+  }
+  return plasticity;
+}
+
 Material parse_material(const SceneValue& value) {
-  value.expect_object({"model", "youngs_modulus", "poisson_ratio", "density", "damping"});
+  value.expect_object(
+      {"model", "youngs_modulus", "poisson_ratio", "density", "damping", "plasticity"});
   Material material;
   const int model = value.at("model").choice({"stvk", "corotated", "neohookean"});
   material.model = static_cast<MaterialModel>(model);
@@ -146,14 +174,16 @@ Material parse_material(const SceneValue& value) {
       material.stiffness_damping = damping.at("stiffness").non_negative();
     }
   }
+  if (value.has("plasticity")) material.plasticity = parse_plasticity(value.at("plasticity"));
   return material;
 }
 
 DirichletSpec parse_prescribed(const SceneValue& value) {
-  value.expect_object({"region", "displacement", "rotation"});
+  value.expect_object({"region", "displacement", "rotation", "amplitude"});
   DirichletSpec spec;
   spec.name = value.path();
   spec.region = parse_region(value.at("region"));
+  if (value.has("amplitude")) spec.amplitude = parse_amplitude(value.at("amplitude"));
   if (value.has("displacement") == value.has("rotation")) {
     value.fail("must have exactly one of displacement, rotation");
   }
@@ -174,7 +204,8 @@ DirichletSpec parse_prescribed(const SceneValue& value) {
 
 SolverSettings parse_solver(const SceneValue& value) {
   value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "linear_solver",
-                       "newton_tolerance", "max_newton_iterations", "hessian"});
+                       "newton_tolerance", "max_newton_iterations", "hessian",
+                       "max_plastic_passes", "plastic_tolerance"});
   SolverSettings solver;
   solver.mode = static_cast<SimulationMode>(value.at("mode").choice({"dynamic", "static"}));
   if (value.has("integrator")) {
@@ -201,6 +232,12 @@ SolverSettings parse_solver(const SceneValue& value) {
   }
   if (value.has("hessian"))
     solver.exact_hessian = value.at("hessian").choice({"projected", "exact_where_pd"}) == 1;
+  if (value.has("max_plastic_passes")) {
+    solver.max_plastic_passes = value.at("max_plastic_passes").integer(1);
+  }
+  if (value.has("plastic_tolerance")) {
+    solver.plastic_tolerance = value.at("plastic_tolerance").positive();
+  }
   return solver;
 }
 
@@ -272,9 +309,11 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   }
   if (top.has("forces")) {
     for (const SceneValue& entry : top.at("forces").elements()) {
-      entry.expect_object({"region", "total_force"});
-      scene.forces.push_back(
-          {entry.path(), parse_region(entry.at("region")), entry.at("total_force").vec3()});
+      entry.expect_object({"region", "total_force", "amplitude"});
+      RegionLoad load{entry.path(), parse_region(entry.at("region")),
+                      entry.at("total_force").vec3()};
+      if (entry.has("amplitude")) load.amplitude = parse_amplitude(entry.at("amplitude"));
+      scene.forces.push_back(std::move(load));
     }
   }
   if (top.has("ground")) {

@@ -124,7 +124,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
                        {"dofs_after", change.dofs_after},
                        {"energy_before", change.energy_before},
                        {"energy_after", change.energy_after},
-                       {"seconds", change.seconds}});
+                       {"seconds", change.seconds},
+                       {"plastic_merge_change", change.plastic_merge_change}});
   }
   block["refinements"] = refinements;
   block["coarsenings"] = coarsenings;
@@ -196,6 +197,23 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                        {"density", scene.material.density},
                        {"mass_damping", scene.material.mass_damping},
                        {"stiffness_damping", scene.material.stiffness_damping}};
+  if (scene.material.plasticity) {
+    const Plasticity& plasticity = *scene.material.plasticity;
+    nlohmann::json block = {{"yield_stress", plasticity.yield_stress},
+                            {"hardening", plasticity.hardening},
+                            {"passes", counters.plastic_passes},
+                            {"unconverged_steps", counters.plastic_unconverged_steps},
+                            {"yielded_tets", counters.yielded_tets}};
+    if (std::isfinite(plasticity.max_plastic_strain))
+      block["max_plastic_strain"] = plasticity.max_plastic_strain;
+    const VectorXd& strain = simulation.plastic_state().equivalent_strain;
+    block["largest_plastic_strain"] = strain.size() > 0 ? strain.maxCoeff() : 0.0;
+    Index plastic_tets = 0;
+    for (Index t = 0; t < strain.size(); ++t)
+      plastic_tets += strain[t] > 0.0;
+    block["plastic_tets"] = plastic_tets;
+    stats["plasticity"] = block;
+  }
   stats["mode"] = to_string(scene.solver.mode);
   if (scene.solver.mode == SimulationMode::dynamic) {
     stats["integrator"] = to_string(scene.solver.integrator);
@@ -388,6 +406,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   progress.clear();
   save_tables();
   finish();
+  if (const SimulationCounters counters = scene_simulation.counters();
+      counters.plastic_unconverged_steps > 0) {
+    log.flush();
+    std::cerr << "strata: warning: " << scene.file.string() << ": the plastic state had not settled "
+              << "within solver.max_plastic_passes = " << scene.solver.max_plastic_passes << " at "
+              << counters.plastic_unconverged_steps << " of " << summary.steps
+              << " steps (solver.plastic_tolerance " << scene.solver.plastic_tolerance << ")\n";
+  }
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
       adaptive && adaptive->settings().mode == HierarchyMode::adaptive) {
     const ToleranceReport& report = adaptive->tolerance_report();

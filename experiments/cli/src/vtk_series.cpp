@@ -40,6 +40,10 @@ void VtkSeries::write_frame(double time, const Simulation& simulation, const Vec
   fields.add_cell_data("green_strain", Eigen::MatrixXd(tet_fields.green_strain));
   fields.add_cell_data("stress", Eigen::MatrixXd(tet_fields.cauchy_stress));
   fields.add_cell_data("von_mises", Eigen::MatrixXd(tet_fields.von_mises));
+  if (simulation.is_plastic()) {
+    fields.add_cell_data("plastic_strain",
+                         Eigen::MatrixXd(simulation.plastic_state().equivalent_strain));
+  }
   fields.add_cell_data("level", levels
                                     ? Eigen::MatrixXi(*levels)
                                     : Eigen::MatrixXi(Eigen::MatrixXi::Zero(mesh.tets.rows(), 1)));

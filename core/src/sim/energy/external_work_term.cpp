@@ -3,7 +3,7 @@
 namespace strata {
 
 void ExternalWorkTerm::add_gradient(ConstRef<VectorXd>, VectorXd& gradient) const {
-  gradient -= m_scale * m_forces;
+  gradient -= m_scale * *m_forces;
 }
 
 }  // namespace strata

@@ -105,6 +105,9 @@ struct CutChangeRecord {
   Vector3d momentum_before = Vector3d::Zero();  ///< Σ m_q v_q just before the change [kg·m/s]
   Vector3d momentum_after = Vector3d::Zero();   ///< … just after
   double seconds = 0.0;  ///< wall time of the change (decide, edit, flatten, rebuild)
+  /// Plastic materials: largest |ε̄ₚ(child) − ε̄ₚ(parent)| over the merges of this change (the
+  /// detail a merge averages away; 0 without merges or plasticity).
+  double plastic_merge_change = 0.0;
 };
 
 /// The active cut after a step.
@@ -193,9 +196,11 @@ class AdaptiveSimulation final : public SimulationRun {
   void rebuild(long first_step);
   bool adapt(int pass, bool refine, bool coarsen);
   /// Changes the cut by `changes` and moves the mesh-level state (x, v) of the current cut, with
-  /// its kinetic energy and momentum, onto it; the new Simulation starts at `first_step`.
+  /// its kinetic energy, momentum and per-tet plastic state, onto it; the new Simulation starts at
+  /// `first_step`.
   void change_cut(const CutChanges& changes, int pass, long first_step, const VectorXd& x,
-                  const VectorXd& v, double old_kinetic_energy, const Vector3d& old_momentum);
+                  const VectorXd& v, double old_kinetic_energy, const Vector3d& old_momentum,
+                  const PlasticState& plastic);
   CutChanges decide(bool refine, bool coarsen);
   void advance_with_redo();
   void initial_adaptation();
@@ -221,7 +226,9 @@ class AdaptiveSimulation final : public SimulationRun {
   std::unique_ptr<ActiveCut> m_cut;
   std::unique_ptr<TreePointLocator> m_locator;
   std::unique_ptr<RefinementController> m_controller;
-  std::vector<PointLoad> m_point_loads;
+  std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
+  /// Loads with an amplitude, each on the finest level.
+  std::vector<std::pair<Amplitude, std::vector<PointLoad>>> m_timed_point_loads;
   std::unique_ptr<ConstrainedCut> m_constrained;
   VectorXd m_mesh_external;  ///< 3·#V of the current cut: gravity + mapped point loads
   VectorXd m_load_traction;  ///< #T of the current cut: largest finest-level load traction

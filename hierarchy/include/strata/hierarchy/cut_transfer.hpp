@@ -14,6 +14,7 @@
 /// Afterwards q = constraints.restrict_to_free(x) gives the target's free DOFs; its hanging
 /// vertices then follow x = C q (on coarsening this moves vertices that were free before onto their
 /// constraint).
+#include "strata/core/fem/plasticity.hpp"
 #include "strata/hierarchy/tree_flatten.hpp"
 
 namespace strata {
@@ -23,5 +24,15 @@ namespace strata {
 /// source nor reachable through parents that are.
 VectorXd transfer_vertex_values(const TetTree& tree, const FlatTreeMesh& source,
                                 ConstRef<VectorXd> source_values, const FlatTreeMesh& target);
+
+/// Per-tet plastic state (plasticity.hpp) carried from `source` to `target` through the tree nodes:
+/// a node active in both keeps its state; a node below a source node (refinement) inherits its
+/// ancestor's Fₚ and ε̄ₚ (plastic deformation is uniform over a linear tet); a node above source
+/// nodes (coarsening) gets their rest-volume-weighted mean of ε̄ₚ and of Fₚ⁻¹, the latter scaled to
+/// det 1. `max_merge_change`, if given, receives the largest |ε̄ₚ(child) − ε̄ₚ(merged parent)|
+/// (0 without merges). Throws std::logic_error if a target node is related to no source node.
+PlasticState transfer_plastic_state(const TetTree& tree, const FlatTreeMesh& source,
+                                    const PlasticState& source_state, const FlatTreeMesh& target,
+                                    double* max_merge_change = nullptr);
 
 }  // namespace strata

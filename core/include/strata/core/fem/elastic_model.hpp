@@ -53,8 +53,17 @@ class ElasticModel {
   /// Smallest J = det F over the tets and the index of that tet (a NaN counts as smallest; ties
   /// go to the smaller index). Parallel.
   std::pair<double, Index> min_volume_ratio(ConstRef<VectorXd> x) const;
-  /// Green strain, Cauchy stress and von Mises stress per tet.
+  /// Green strain of the total F, and the Cauchy and von Mises stress of the elastic part
+  /// Fₑ = F Fₚ⁻¹, per tet.
   TetFields tet_fields(ConstRef<VectorXd> x) const;
+
+  /// Plastic deformation per tet (plasticity.hpp): every tet's energy becomes V ψ(F Fₚ⁻¹), i.e.
+  /// Dm⁻¹ is replaced by Dm⁻¹ Fₚ⁻¹ in every kernel. `plastic_inverse`: Fₚ⁻¹ per tet (#T, each with
+  /// det 1 up to round-off); empty: Fₚ = I everywhere. Not thread-safe against concurrent
+  /// evaluations.
+  void set_plastic_inverse(const std::vector<Matrix3d>& plastic_inverse);
+  /// Fₚ⁻¹ per tet; empty while Fₚ = I everywhere.
+  const std::vector<Matrix3d>& plastic_inverse() const { return m_plastic_inverse; }
 
   /// Element evaluations so far (each tet visited by energy/forces/stiffness counts once).
   long long element_evaluations() const { return m_element_evaluations.load(); }
@@ -64,6 +73,8 @@ class ElasticModel {
   void accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
                          double* energy) const;
   void build_stiffness_pattern();
+  /// Writes the kernels' rest arrays from Dm⁻¹ (and Fₚ⁻¹ if set).
+  void fill_rest_arrays();
 
   Index m_num_vertices;
   MatrixX4i m_tets;
@@ -80,6 +91,7 @@ class ElasticModel {
   /// Dm⁻¹ and rest volume in lane groups for the vectorised kernels, kLaneRest per group.
   static constexpr int kLaneRest = 40;
   std::vector<double> m_lane_rest;
+  std::vector<Matrix3d> m_plastic_inverse;  ///< #T in mesh order, or empty
   SparseMatrixd m_pattern;
   /// For sorted tet i, vertex pair (a, b) and column c: offset in K's value array of the entry
   /// (3·v_a, 3·v_b + c); rows 3·v_a + 1 and 3·v_a + 2 follow it. 48 per tet.

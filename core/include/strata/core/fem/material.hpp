@@ -1,7 +1,10 @@
 #pragma once
 /// \file material.hpp
 /// Isotropic hyperelastic material: model choice and parameters.
+#include <optional>
 #include <string>
+
+#include "strata/core/fem/plasticity.hpp"
 
 namespace strata {
 
@@ -30,7 +33,7 @@ struct LameParameters {
 };
 LameParameters lame_parameters(double youngs_modulus, double poisson_ratio);
 
-/// A material: model, elastic constants, density and Rayleigh damping.
+/// A material: model, elastic constants, density, Rayleigh damping and optional plasticity.
 struct Material {
   MaterialModel model = MaterialModel::stvk;
   double youngs_modulus = 1e6;     ///< E [Pa]
@@ -38,14 +41,16 @@ struct Material {
   double density = 1000.0;         ///< ρ [kg/m³]
   double mass_damping = 0.0;       ///< Rayleigh α [1/s]: damping force −α M v
   double stiffness_damping = 0.0;  ///< Rayleigh β [s]: damping force −β K v
+  /// von Mises plasticity (plasticity.hpp); none: purely elastic.
+  std::optional<Plasticity> plasticity;
 
   LameParameters lame() const { return lame_parameters(youngs_modulus, poisson_ratio); }
   /// P-wave speed √((λ + 2μ)/ρ) [m/s], the fastest elastic wave.
   double p_wave_speed() const;
 };
 
-/// Throws InputError (naming `where`, e.g. "material") unless E > 0, 0 ≤ ν < 0.5, ρ > 0 and the
-/// damping coefficients are ≥ 0.
+/// Throws InputError (naming `where`, e.g. "material") unless E > 0, 0 ≤ ν < 0.5, ρ > 0, the
+/// damping coefficients are ≥ 0 and the plasticity (if any) is valid.
 void validate_material(const Material& material, const std::string& where);
 
 }  // namespace strata

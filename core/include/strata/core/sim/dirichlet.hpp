@@ -1,7 +1,9 @@
 #pragma once
 /// \file dirichlet.hpp
-/// Dirichlet (prescribed-motion) vertex groups, ramped by a factor s ∈ [0, 1]: in dynamic runs
-/// s = t / ramp_time (clamped at 1), in static runs s is the load factor.
+/// Dirichlet (prescribed-motion) vertex groups, scaled by a factor s: by default in dynamic runs
+/// s = t / ramp_time (clamped at 1), in static runs s is the load factor; a group with an
+/// `amplitude` table follows s(t) of that table instead (amplitude.hpp; t is the load factor in
+/// static runs).
 ///
 /// Kinds, for a vertex with rest position X:
 /// - fixed: u = 0, target x = X.
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "strata/core/common/types.hpp"
+#include "strata/core/sim/amplitude.hpp"
 #include "strata/core/sim/region.hpp"
 
 namespace strata {
@@ -37,6 +40,7 @@ struct DirichletSpec {
   bool has_center = false;                   ///< rotation center given?
   Vector3d center = Vector3d::Zero();        ///< rotation center [m] (rotation, if has_center)
   std::array<bool, 3> components = {true, true, true};  ///< prescribed coordinates x, y, z
+  Amplitude amplitude;  ///< load history s(t); empty: the run's default ramp
 };
 
 /// A group resolved against a mesh: its vertices and moment center.
@@ -47,6 +51,10 @@ struct DirichletGroup {
   /// rest centroid of the group's vertices.
   Vector3d moment_center = Vector3d::Zero();
 
+  /// The group's factor at time t: its amplitude s(t), or `default_s` without one.
+  double factor(double t, double default_s) const;
+  /// ds/dt at time t: the amplitude's slope, or `default_rate` without one.
+  double factor_rate(double t, double default_rate) const;
   /// Target position of a vertex with rest position X at ramp factor s.
   Vector3d target_position(const Vector3d& X, double s) const;
   /// Target velocity dx/dt given ds/dt.
@@ -68,9 +76,10 @@ VectorXi dirichlet_owner(const std::vector<DirichletGroup>& groups, Index num_ve
 /// Per-DOF constrained flag (3·#V entries, 1 = prescribed; only the groups' components).
 std::vector<char> dirichlet_dof_mask(const std::vector<DirichletGroup>& groups, Index num_vertices);
 
-/// Writes the target positions and velocities of all constrained DOFs into `x` and `v` (3·#V
-/// each); free DOFs are left untouched. `rest` is 3·#V.
-void apply_dirichlet(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest, double s,
-                     double ds_dt, VectorXd& x, VectorXd& v);
+/// Writes the target positions and velocities at time t of all constrained DOFs into `x` and `v`
+/// (3·#V each); free DOFs are left untouched. `rest` is 3·#V. Groups without an amplitude use the
+/// factor `default_s` and its rate `default_rate`.
+void apply_dirichlet(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest, double t,
+                     double default_s, double default_rate, VectorXd& x, VectorXd& v);
 
 }  // namespace strata

@@ -11,6 +11,7 @@
 /// set to their targets at t + h, eliminated. Unconditionally stable for the linear problem.
 #include "strata/core/sim/dof_reduction.hpp"
 #include "strata/core/sim/energy/energy_term.hpp"
+#include "strata/core/sim/energy/external_work_term.hpp"
 #include "strata/core/sim/energy/inertia_term.hpp"
 #include "strata/core/sim/energy/rayleigh_damping_term.hpp"
 #include "strata/core/sim/linear_solver.hpp"
@@ -38,6 +39,8 @@ class ImplicitEuler {
   DofReduction m_reduction;
   NewtonControls m_controls;
   EnergySum m_energy;
+  ExternalWorkTerm* m_external = nullptr;
+  VectorXd m_timed_external;  ///< f_ext(t + h) when loads follow amplitudes
   InertiaTerm* m_inertia = nullptr;
   RayleighDampingTerm* m_damping = nullptr;
 };

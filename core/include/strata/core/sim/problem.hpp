@@ -21,6 +21,7 @@
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/embedded_model.hpp"
 #include "strata/core/sim/ground_contact.hpp"
+#include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/multigrid.hpp"
 
 namespace strata {
@@ -30,7 +31,9 @@ class EnergySum;
 struct Problem {
   const EmbeddedElasticModel& model;  ///< elastic forces on the DOFs q (x = P q)
   const VectorXd& dof_mass;           ///< lumped mass per DOF, 3·#Q [kg]
-  const VectorXd& external_forces;    ///< f_ext at full load, 3·#Q [N]
+  /// f_ext of the loads without an amplitude at full load, 3·#Q [N]: constant in dynamic runs,
+  /// scaled by the load factor in static ones.
+  const VectorXd& external_forces;
   const std::vector<DirichletGroup>& groups;
   const std::vector<char>& constrained;  ///< 3·#Q flags
   double mass_damping = 0.0;             ///< α [1/s]
@@ -42,11 +45,18 @@ struct Problem {
   /// Optional coarser spaces below the DOF vertices (the refinement tree's levels) for the
   /// multigrid linear solver; null: none.
   const NestedSpaces* nested_spaces = nullptr;
+  /// Loads that follow their own amplitude s_k(t) (3·#Q each); null or empty: none.
+  const std::vector<TimedForces>* timed_forces = nullptr;
 
   /// s(t) = min(t / T_r, 1).
   double ramp(double t) const;
   /// ds/dt: 1/T_r while ramping, 0 after.
   double ramp_rate(double t) const;
+  /// Whether any load follows its own amplitude.
+  bool has_timed_forces() const { return timed_forces != nullptr && !timed_forces->empty(); }
+  /// f = base_scale · external_forces + Σ_k s_k(t) f_k (3·#Q): the external forces at time t
+  /// (base_scale 1) or at load factor λ = t (base_scale λ).
+  void external_forces_at(double t, double base_scale, VectorXd& f) const;
   /// Writes the Dirichlet targets at time t into x and v.
   void apply_constraints(double t, VectorXd& x, VectorXd& v) const;
   /// Adds −(α M + β K(x)) v into `f`, K v by finite difference; `f_int` = f_int(x).

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "strata/core/fem/elastic_model.hpp"
+#include "strata/core/fem/plasticity.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/divergence_check.hpp"
@@ -62,6 +63,9 @@ struct SimulationOptions {
   /// Dead loads on the mesh vertices (3·#V [N]) added to gravity and the region loads, e.g. loads
   /// defined on a finer mesh and mapped onto this one; empty for none.
   VectorXd extra_mesh_forces;
+  /// Mesh-vertex loads that follow their own amplitude (3·#V each), added to those of the region
+  /// loads with an amplitude.
+  std::vector<TimedForces> extra_timed_mesh_forces;
   /// Step index the run starts from: time() = (first_step + steps taken) · dt in dynamic mode,
   /// load factor (first_step + steps taken) / load_steps in static mode, and the Dirichlet ramp
   /// continues from there.
@@ -69,6 +73,9 @@ struct SimulationOptions {
   /// Coarser spaces below the DOF vertices for the multigrid linear solver (the refinement tree's
   /// levels, hierarchy/cut_levels.hpp); empty: none.
   NestedSpaces nested_spaces;
+  /// Plastic state per mesh tet to start from (material with plasticity only); empty: virgin
+  /// material (Fₚ = I, ε̄ₚ = 0).
+  PlasticState plastic_state;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
@@ -94,6 +101,12 @@ struct SimulationCounters {
   /// Largest final ‖residual‖ / residual target over the Newton solves (≤ 1 unless a solve
   /// converged on the increment or stalled).
   double max_residual_ratio = 0.0;
+  /// Plasticity: return mappings done (one per explicit step; one per solve of an implicit or
+  /// static step), steps whose passes ended before the plastic tolerance was met, and the tets
+  /// that flowed in the last step.
+  long plastic_passes = 0;
+  long plastic_unconverged_steps = 0;
+  Index yielded_tets = 0;
 };
 
 class Simulation final : public SimulationRun {
@@ -150,7 +163,8 @@ class Simulation final : public SimulationRun {
   double kinetic_energy() const;  ///< ½ v_qᵀ M_q v_q [J]
   double elastic_energy() const;  ///< Ψ(x) [J]
   /// Potential of the dead loads −s_f f_extᵀ(x − X) [J] (s_f = load factor in static mode, 1 in
-  /// dynamic mode).
+  /// dynamic mode); with loads that follow amplitudes, that of the loads acting now,
+  /// −f_ext(t)ᵀ(x − X).
   double external_potential_energy() const;
   SimulationCounters counters() const override;
   /// A plain run is its own current simulation.
@@ -167,12 +181,29 @@ class Simulation final : public SimulationRun {
   const VectorXd& vertex_mass() const { return m_vertex_mass; }  ///< mesh, #V [kg]
   /// Lumped masses of the DOF vertices, Cᵀ m (#Q) [kg].
   const VectorXd& dof_vertex_mass() const { return m_dof_vertex_mass; }
-  /// Full (unscaled) external force vector on the DOFs, 3·#Q [N].
+  /// Full (unscaled) external force vector of the loads without an amplitude on the DOFs,
+  /// 3·#Q [N].
   const VectorXd& external_forces() const { return m_external; }
+  /// The loads with an amplitude on the DOFs (3·#Q each).
+  const std::vector<TimedForces>& timed_forces() const { return m_timed; }
+  /// External forces acting on the DOFs in the current state, 3·#Q [N]: at the load factor in
+  /// static runs, at the current time in dynamic ones.
+  VectorXd current_external_forces() const;
   const DivergenceLimits& divergence_limits() const { return m_limits; }
+  /// Whether the material is plastic.
+  bool is_plastic() const { return m_material.plasticity.has_value(); }
+  /// Plastic state per mesh tet (empty unless is_plastic()).
+  const PlasticState& plastic_state() const { return m_plastic; }
+  /// Replaces the plastic state (#T entries; e.g. carried over from another cut). Throws
+  /// InputError for a material without plasticity or a size mismatch.
+  void set_plastic_state(PlasticState state);
 
  private:
   void update_mesh_state();
+  /// Return mapping after a step from t0 to t1 (step h) whose start state was (q, v); implicit and
+  /// static steps are repeated with the updated state until it settles.
+  void update_plastic_state(double t0, double t1, double h, const VectorXd& q_start,
+                            const VectorXd& v_start);
   bool is_static() const;
   [[noreturn]] void throw_newton_failure(const std::string& context, int iterations,
                                          double residual) const;
@@ -187,6 +218,7 @@ class Simulation final : public SimulationRun {
   VectorXd m_dof_vertex_mass;
   VectorXd m_dof_mass;
   VectorXd m_external;
+  std::vector<TimedForces> m_timed;
   std::vector<DirichletGroup> m_groups;
   std::vector<char> m_constrained;
   std::optional<GroundPlane> m_ground;
@@ -205,7 +237,8 @@ class Simulation final : public SimulationRun {
   VectorXd m_mesh_v;
   long m_first_step = 0;
   long m_steps = 0;
-  SimulationCounters m_newton;  ///< Newton fields only
+  PlasticState m_plastic;
+  SimulationCounters m_newton;  ///< Newton and plasticity fields only
   void record_newton(const NewtonResult& result);
 };
 

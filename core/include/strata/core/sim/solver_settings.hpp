@@ -32,6 +32,11 @@ struct SolverSettings {
   bool exact_hessian = true;
   /// Ground penalty stiffness factor (static mode), see ground_penalty_stiffness.
   double contact_stiffness_factor = 100.0;
+  /// Plasticity (implicit and static steps): a step is repeated with the updated plastic state
+  /// until no tet's ε̄ₚ changes by more than plastic_tolerance × σ_y / E between passes, at most
+  /// max_plastic_passes solves per step (then the step is kept and counted as unconverged).
+  int max_plastic_passes = 25;
+  double plastic_tolerance = 1e-3;
 };
 
 std::string to_string(SimulationMode mode);    ///< "dynamic" | "static"
@@ -43,8 +48,8 @@ Integrator integrator_from_string(const std::string& name);
 LinearSolverKind linear_solver_from_string(const std::string& name);
 
 /// Throws InputError naming `where` (e.g. "solver") unless dt > 0, duration > 0, ramp_time ≥ 0,
-/// load_steps ≥ 1, max_newton_iterations ≥ 1, newton_tolerance > 0, contact factor > 0 (all
-/// finite).
+/// load_steps ≥ 1, max_newton_iterations ≥ 1, newton_tolerance > 0, contact factor > 0,
+/// max_plastic_passes ≥ 1, plastic_tolerance > 0 (all finite).
 void validate_solver_settings(const SolverSettings& settings, const std::string& where);
 
 }  // namespace strata

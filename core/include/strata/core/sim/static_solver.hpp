@@ -42,6 +42,7 @@ class StaticSolver {
   NewtonControls m_controls;
   EnergySum m_energy;
   ExternalWorkTerm* m_external = nullptr;
+  VectorXd m_timed_external;  ///< f_ext(λ) when loads follow amplitudes
 };
 
 }  // namespace strata
