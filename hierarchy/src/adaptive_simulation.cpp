@@ -164,7 +164,8 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
       continue;
     }
     validate_amplitude(load.amplitude, load.name + ".amplitude");
-    m_timed_point_loads.emplace_back(load.amplitude, finest_level_loads(*m_tree, {load}, m_tolerance));
+    m_timed_point_loads.emplace_back(load.amplitude,
+                                     finest_level_loads(*m_tree, {load}, m_tolerance));
   }
   m_point_loads = finest_level_loads(*m_tree, constant_loads, m_tolerance);
   make_dirichlet_exact();
@@ -427,9 +428,8 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
     const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
     if (!plastic.empty())
-      m_simulation->set_plastic_state(transfer_plastic_state(*m_tree, old_cut->flat, plastic,
-                                                             new_flat,
-                                                             &record.plastic_merge_change));
+      m_simulation->set_plastic_state(transfer_plastic_state(
+          *m_tree, old_cut->flat, plastic, new_flat, &record.plastic_merge_change));
     m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
     keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_simulation->dof_vertex_mass(),
                         old_kinetic_energy, old_momentum);

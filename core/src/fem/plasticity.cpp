@@ -64,8 +64,8 @@ ElementReturn return_map(const Matrix3d& F, const Matrix3d& plastic_inverse,
   // Δε = −Δε̄ √(3/2) n along the unit deviator n; traceless, so det e^{Δε} = 1.
   const Vector3d delta = -increment * std::sqrt(1.5) * deviator / deviator_norm;
   const Matrix3d& V = svd.matrixV();
-  result.plastic_inverse = plastic_inverse * (V * delta.array().exp().matrix().asDiagonal() *
-                                              V.transpose());
+  result.plastic_inverse =
+      plastic_inverse * (V * delta.array().exp().matrix().asDiagonal() * V.transpose());
   result.equivalent_strain = equivalent_strain + increment;
   result.yielded = true;
   return result;
@@ -74,9 +74,9 @@ ElementReturn return_map(const Matrix3d& F, const Matrix3d& plastic_inverse,
 PlasticState return_map(const ElasticModel& model, ConstRef<VectorXd> x, const PlasticState& start,
                         const Plasticity& plasticity, Index* yielded) {
   const Index num_tets = model.num_tets();
-  STRATA_VERIFY(start.num_tets() == num_tets &&
-                    static_cast<Index>(start.plastic_inverse.size()) == num_tets,
-                "return_map: plastic state does not match the mesh");
+  STRATA_VERIFY(
+      start.num_tets() == num_tets && static_cast<Index>(start.plastic_inverse.size()) == num_tets,
+      "return_map: plastic state does not match the mesh");
   STRATA_VERIFY(x.size() == model.num_dofs(), "return_map: position vector size");
   const LameParameters lame = model.material().lame();
   const MatrixX4i& tets = model.tets();

@@ -158,8 +158,8 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
   m_v = is_static() ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
   m_stepper->reset_history();
   if (is_static()) {
-    apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), load_factor(), 0.0,
-                    m_x, m_v);
+    apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), load_factor(), 0.0, m_x,
+                    m_v);
     m_v.setZero();
   } else {
     m_system->apply_constraints(time(), m_x, m_v);
@@ -206,7 +206,8 @@ void Simulation::advance() {
 }
 
 void Simulation::set_plastic_state(PlasticState state) {
-  if (!is_plastic()) throw InputError("simulation: plastic state for a material without plasticity");
+  if (!is_plastic())
+    throw InputError("simulation: plastic state for a material without plasticity");
   if (state.num_tets() != m_mesh.tets.rows() ||
       static_cast<Index>(state.plastic_inverse.size()) != m_mesh.tets.rows())
     throw InputError("simulation: plastic state must hold " + std::to_string(m_mesh.tets.rows()) +
@@ -215,29 +216,76 @@ void Simulation::set_plastic_state(PlasticState state) {
   m_model->set_plastic_inverse(m_plastic.plastic_inverse);
 }
 
+namespace {
+
+/// A plastic state as one vector: ε̄ₚ of every tet, then the 9 entries of every Fₚ⁻¹.
+VectorXd pack(const PlasticState& state) {
+  const Index n = state.num_tets();
+  VectorXd z(10 * n);
+  z.head(n) = state.equivalent_strain;
+  for (Index t = 0; t < n; ++t)
+    z.segment<9>(n + 9 * t) = Eigen::Map<const Vector9d>(state.plastic_inverse[t].data());
+  return z;
+}
+
+/// The inverse of pack, with each Fₚ⁻¹ scaled back to det 1 and ε̄ₚ kept at or above `floor`.
+void unpack(ConstRef<VectorXd> z, const VectorXd& floor, PlasticState& state) {
+  const Index n = state.num_tets();
+  state.equivalent_strain = z.head(n).cwiseMax(floor);
+  for (Index t = 0; t < n; ++t) {
+    Matrix3d inverse = Eigen::Map<const Matrix3d>(z.data() + n + 9 * t);
+    const double det = inverse.determinant();
+    if (det > 0.0) inverse /= std::cbrt(det);
+    state.plastic_inverse[t] = inverse;
+  }
+}
+
+}  // namespace
+
 void Simulation::update_plastic_state(double t0, double t1, double h, const VectorXd& q_start,
                                       const VectorXd& v_start) {
+  // Fixed point of "solve with the plastic state, return-map from the start-of-step state": each
+  // solve sees the elastic stiffness, so plain iteration contracts only by 1 − E_t/E per pass
+  // (E_t the elastoplastic tangent). Aitken's dynamic relaxation (Irons & Tuck 1969) of the
+  // state update makes it a few passes; the accepted state is always a plain return mapping.
   const Plasticity& plasticity = *m_material.plasticity;
   const PlasticState start = m_plastic;
   const double tolerance =
       m_settings.plastic_tolerance * plasticity.yield_stress / m_material.youngs_modulus;
+  const Index num_tets = start.num_tets();
+  VectorXd used = pack(start);  // the state the last solve used
+  VectorXd previous_residual;
+  double relaxation = 1.0;
   for (int pass = 1;; ++pass) {
     Index yielded = 0;
-    PlasticState next = return_map(*m_model, positions(), start, plasticity, &yielded);
-    const double change =
-        next.num_tets() == 0
-            ? 0.0
-            : (next.equivalent_strain - m_plastic.equivalent_strain).cwiseAbs().maxCoeff();
-    m_plastic = std::move(next);
-    m_model->set_plastic_inverse(m_plastic.plastic_inverse);
+    PlasticState mapped = return_map(*m_model, positions(), start, plasticity, &yielded);
     ++m_newton.plastic_passes;
     m_newton.yielded_tets = yielded;
-    if (m_stepper_traits->is_explicit || change <= tolerance) return;
-    if (pass >= m_settings.max_plastic_passes) {
-      ++m_newton.plastic_unconverged_steps;
+    const VectorXd image = pack(mapped);
+    const VectorXd residual = image - used;
+    const double change = num_tets == 0 ? 0.0 : residual.head(num_tets).cwiseAbs().maxCoeff();
+    const bool last = m_stepper_traits->is_explicit || change <= tolerance ||
+                      pass >= m_settings.max_plastic_passes;
+    if (last) {
+      if (!(m_stepper_traits->is_explicit || change <= tolerance))
+        ++m_newton.plastic_unconverged_steps;
+      m_plastic = std::move(mapped);
+      m_model->set_plastic_inverse(m_plastic.plastic_inverse);
       return;
     }
-    // The step again, with the plastic state of this pass.
+    if (previous_residual.size() > 0) {
+      const VectorXd difference = residual - previous_residual;
+      const double denominator = difference.squaredNorm();
+      if (denominator > 0.0)
+        relaxation =
+            std::clamp(-relaxation * previous_residual.dot(difference) / denominator, 0.1, 100.0);
+    }
+    previous_residual = residual;
+    used += relaxation * residual;
+    unpack(used, start.equivalent_strain, m_plastic);
+    used = pack(m_plastic);
+    m_model->set_plastic_inverse(m_plastic.plastic_inverse);
+    // The step again, with the relaxed plastic state.
     NewtonResult result;
     if (is_static()) {
       result = m_stepper->resolve(t1, m_x, m_v);
@@ -248,9 +296,9 @@ void Simulation::update_plastic_state(double t0, double t1, double h, const Vect
     }
     record_newton(result);
     if (!result.converged)
-      throw_newton_failure(std::string(m_stepper_traits->name) + " (plastic pass " +
-                               std::to_string(pass + 1) + ")",
-                           result.iterations, result.residual);
+      throw_newton_failure(
+          std::string(m_stepper_traits->name) + " (plastic pass " + std::to_string(pass + 1) + ")",
+          result.iterations, result.residual);
     if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
     update_mesh_state();
   }

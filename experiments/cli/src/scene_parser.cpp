@@ -204,8 +204,8 @@ DirichletSpec parse_prescribed(const SceneValue& value) {
 
 SolverSettings parse_solver(const SceneValue& value) {
   value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "linear_solver",
-                       "newton_tolerance", "max_newton_iterations", "hessian",
-                       "max_plastic_passes", "plastic_tolerance"});
+                       "newton_tolerance", "max_newton_iterations", "hessian", "max_plastic_passes",
+                       "plastic_tolerance"});
   SolverSettings solver;
   solver.mode = static_cast<SimulationMode>(value.at("mode").choice({"dynamic", "static"}));
   if (value.has("integrator")) {

@@ -409,7 +409,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   if (const SimulationCounters counters = scene_simulation.counters();
       counters.plastic_unconverged_steps > 0) {
     log.flush();
-    std::cerr << "strata: warning: " << scene.file.string() << ": the plastic state had not settled "
+    std::cerr << "strata: warning: " << scene.file.string()
+              << ": the plastic state had not settled "
               << "within solver.max_plastic_passes = " << scene.solver.max_plastic_passes << " at "
               << counters.plastic_unconverged_steps << " of " << summary.steps
               << " steps (solver.plastic_tolerance " << scene.solver.plastic_tolerance << ")\n";
