@@ -180,6 +180,61 @@ TEST(SceneParser, OutOfRangeValues) {
   EXPECT_EQ(parse_error(scene), "scene.json: ground.normal: must not be the zero vector");
 }
 
+TEST(SceneParser, PlasticityAndLoadHistories) {
+  json scene = minimal_scene();
+  scene["material"]["plasticity"] = {{"yield_stress", 2e5}, {"hardening", 1e5}};
+  scene["forces"] = json::parse(R"([{"region": {"sphere": {"center": [1, 0, 0], "radius": 0.1}},
+                                     "total_force": [0, 0, -1],
+                                     "amplitude": [[0, 0], [0.5, 1], [1, 0]]}])");
+  scene["prescribed"] = json::parse(R"([{"region": {"plane": {"point": [1, 0, 0],
+                                                              "normal": [1, 0, 0]}},
+                                         "displacement": [0.01, 0, 0],
+                                         "amplitude": [[0.2, 1]]}])");
+  scene["solver"]["max_plastic_passes"] = 7;
+  scene["solver"]["plastic_tolerance"] = 1e-4;
+  const Scene parsed = parse_scene(scene, "scene.json");
+  ASSERT_TRUE(parsed.material.plasticity.has_value());
+  EXPECT_EQ(parsed.material.plasticity->yield_stress, 2e5);
+  EXPECT_EQ(parsed.material.plasticity->hardening, 1e5);
+  EXPECT_TRUE(std::isinf(parsed.material.plasticity->max_plastic_strain));
+  ASSERT_EQ(parsed.forces.size(), 1u);
+  ASSERT_EQ(parsed.forces[0].amplitude.points.size(), 3u);
+  EXPECT_EQ(parsed.forces[0].amplitude.value(0.25), 0.5);
+  EXPECT_EQ(parsed.forces[0].amplitude.value(2.0), 0.0);
+  ASSERT_EQ(parsed.prescribed.size(), 1u);
+  EXPECT_EQ(parsed.prescribed[0].amplitude.value(0.0), 1.0);  // constant beyond the ends
+  EXPECT_EQ(parsed.solver.max_plastic_passes, 7);
+  EXPECT_EQ(parsed.solver.plastic_tolerance, 1e-4);
+  EXPECT_FALSE(parse_scene(minimal_scene(), "scene.json").material.plasticity.has_value());
+}
+
+TEST(SceneParser, BadPlasticityAndLoadHistoriesNameTheKey) {
+  json scene = minimal_scene();
+  scene["material"]["plasticity"] = {{"yield_stress", -1}};
+  EXPECT_EQ(parse_error(scene), "scene.json: material.plasticity.yield_stress: must be > 0");
+  scene["material"]["plasticity"] = {{"yield_stress", 1e5}, {"hardening", -1}};
+  EXPECT_EQ(parse_error(scene), "scene.json: material.plasticity.hardening: must be >= 0");
+  scene["material"]["plasticity"] = {{"yield_stress", 1e5}, {"softening", 1}};
+  EXPECT_THAT(parse_error(scene), HasSubstr("material.plasticity.softening"));
+  scene["material"]["plasticity"] = {{"hardening", 1}};
+  EXPECT_THAT(parse_error(scene), HasSubstr("material.plasticity.yield_stress"));
+  scene = minimal_scene();
+  scene["forces"] = json::parse(R"([{"region": {"sphere": {"center": [1, 0, 0], "radius": 0.1}},
+                                     "total_force": [0, 0, -1],
+                                     "amplitude": [[0, 0], [0, 1]]}])");
+  EXPECT_EQ(parse_error(scene), "scene.json: forces.0.amplitude.1.0: times must increase strictly");
+  scene["forces"][0]["amplitude"] = json::parse("[[0, 0, 1]]");
+  EXPECT_EQ(parse_error(scene), "scene.json: forces.0.amplitude.0: must be a pair [t, s]");
+  scene["forces"][0]["amplitude"] = json::array();
+  EXPECT_EQ(parse_error(scene),
+            "scene.json: forces.0.amplitude: must hold at least one point [t, s]");
+  scene["forces"][0]["amplitude"] = json::parse(R"([[0, "a"]])");
+  EXPECT_THAT(parse_error(scene), HasSubstr("forces.0.amplitude.0.1: must be a number"));
+  scene = minimal_scene();
+  scene["solver"]["max_plastic_passes"] = 0;
+  EXPECT_EQ(parse_error(scene), "scene.json: solver.max_plastic_passes: must be >= 1");
+}
+
 TEST(SceneParser, UnknownEnumValuesListTheChoices) {
   json scene = minimal_scene();
   scene["solver"] = {{"mode", "dynamic"}, {"integrator", "rk5"}, {"dt", 1e-3}, {"duration", 1}};

@@ -1,0 +1,74 @@
+// End-to-end: a bracket bent beyond yield by a tip load that rises and comes back
+// (material.plasticity, forces[].amplitude) keeps a permanent set that the purely elastic run does
+// not; the run reports its plastic state in stats.json and in the .vtu frames.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cli_test_utils.hpp"
+
+namespace strata::cli_test {
+namespace {
+
+using nlohmann::json;
+
+/// A 1 × 0.1 × 0.1 m cantilever clamped at x = 0; a tip load of 3 kN (a clamp bending stress of
+/// about 6·M/(b h²) = 18 MPa in beam theory, less on this coarse mesh, beyond σ_y = 4 MPa) applied
+/// and removed over 12 load steps.
+json bracket_scene(bool plastic) {
+  json scene = json::parse(R"({
+    "mesh": {"box": {"min": [0, 0, 0], "max": [1, 0.1, 0.1], "cells": [10, 2, 2]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e10, "poisson_ratio": 0.3,
+                 "density": 1000},
+    "fixed": [{"box": {"min": [0, 0, 0], "max": [0, 0.1, 0.1]}}],
+    "forces": [{"region": {"plane": {"point": [1, 0, 0], "normal": [1, 0, 0]}},
+                "total_force": [0, 0, -3000], "amplitude": [[0, 0], [0.5, 1], [1, 0]]}],
+    "solver": {"mode": "static", "load_steps": 12},
+    "output": {"probes": [[1, 0.05, 0.05]]}
+  })");
+  if (plastic) scene["material"]["plasticity"] = {{"yield_stress", 4e6}, {"hardening", 1e9}};
+  return scene;
+}
+
+TEST(CliPlasticity, BentBeyondYieldTheBracketKeepsAPermanentSet) {
+  TempFolder folder;
+  write_text(folder.path() / "elastic.json", bracket_scene(false).dump(2));
+  write_text(folder.path() / "plastic.json", bracket_scene(true).dump(2));
+  const CliResult elastic = run_strata("run elastic.json --quiet", folder.path());
+  ASSERT_EQ(elastic.exit_code, 0) << elastic.err;
+  const CliResult plastic = run_strata("run plastic.json --quiet", folder.path());
+  ASSERT_EQ(plastic.exit_code, 0) << plastic.err;
+
+  const auto tip = [&](const std::string& name) {
+    const Csv probes = read_csv(folder.path() / "out" / name / "probes.csv");
+    std::vector<double> z;  // tip z displacement per frame
+    for (const auto& row : probes.rows)
+      z.push_back(row[row.size() - 1]);
+    return z;
+  };
+  const std::vector<double> elastic_tip = tip("elastic");
+  const std::vector<double> plastic_tip = tip("plastic");
+  ASSERT_EQ(elastic_tip.size(), 13u);
+  ASSERT_EQ(plastic_tip.size(), 13u);
+  const double peak = std::abs(elastic_tip[6]);
+  ASSERT_GT(peak, 0.0);
+  EXPECT_LT(std::abs(elastic_tip.back()), 1e-6 * peak);  // elastic: back to rest
+  EXPECT_GT(std::abs(plastic_tip[6]), peak);             // softer once it yields
+  EXPECT_GT(std::abs(plastic_tip.back()), 0.02 * peak);  // a permanent set, downwards
+  EXPECT_LT(plastic_tip.back(), 0.0);
+
+  const json stats = read_json(folder.path() / "out" / "plastic" / "stats.json");
+  ASSERT_TRUE(stats.contains("plasticity"));
+  EXPECT_EQ(stats["plasticity"]["yield_stress"], 4e6);
+  EXPECT_GT(stats["plasticity"]["largest_plastic_strain"].get<double>(), 0.0);
+  EXPECT_GT(stats["plasticity"]["plastic_tets"].get<int>(), 0);
+  EXPECT_EQ(stats["plasticity"]["unconverged_steps"], 0);
+  EXPECT_GE(stats["plasticity"]["passes"].get<int>(), 12);
+  EXPECT_FALSE(read_json(folder.path() / "out" / "elastic" / "stats.json").contains("plasticity"));
+  const std::string frame = read_text(folder.path() / "out" / "plastic" / "plastic_000012.vtu");
+  EXPECT_THAT(frame, ::testing::HasSubstr("Name=\"plastic_strain\""));
+}
+
+}  // namespace
+}  // namespace strata::cli_test
