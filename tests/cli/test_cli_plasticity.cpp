@@ -70,5 +70,35 @@ TEST(CliPlasticity, BentBeyondYieldTheBracketKeepsAPermanentSet) {
   EXPECT_THAT(frame, ::testing::HasSubstr("Name=\"plastic_strain\""));
 }
 
+TEST(CliPlasticity, AdaptiveCutCarriesThePlasticStateLikeTheFullRun) {
+  // One level of refinement: the adaptive run refines where the bracket yields, carries the
+  // plastic state across its cut changes and ends where the full-resolution run ends.
+  TempFolder folder;
+  json scene = bracket_scene(true);
+  scene["hierarchy"] = {{"levels", 1}};
+  scene["output"]["vtk"] = false;
+  write_text(folder.path() / "bracket.json", scene.dump(2));
+  const CliResult full = run_strata(
+      "run bracket.json --quiet --out full --set hierarchy.mode=\"full\"", folder.path());
+  ASSERT_EQ(full.exit_code, 0) << full.err;
+  const CliResult adaptive = run_strata("run bracket.json --quiet --out adaptive", folder.path());
+  ASSERT_EQ(adaptive.exit_code, 0) << adaptive.err;
+  const Csv full_probes = read_csv(folder.path() / "full" / "probes.csv");
+  const Csv adaptive_probes = read_csv(folder.path() / "adaptive" / "probes.csv");
+  ASSERT_EQ(full_probes.rows.size(), adaptive_probes.rows.size());
+  double peak = 0.0, largest = 0.0;
+  for (std::size_t i = 0; i < full_probes.rows.size(); ++i) {
+    peak = std::max(peak, std::abs(full_probes.rows[i].back()));
+    largest =
+        std::max(largest, std::abs(full_probes.rows[i].back() - adaptive_probes.rows[i].back()));
+  }
+  ASSERT_GT(peak, 0.0);
+  EXPECT_LT(largest, 0.02 * peak);  // the scene's hierarchy.tolerance is 0.01 of the same measure
+  const json stats = read_json(folder.path() / "adaptive" / "stats.json");
+  EXPECT_GT(stats["plasticity"]["plastic_tets"].get<int>(), 0);
+  EXPECT_GT(stats["hierarchy"]["refinements"].get<int>(), 0);
+  EXPECT_GT(std::abs(full_probes.rows.back().back()), 0.02 * peak);  // the permanent set
+}
+
 }  // namespace
 }  // namespace strata::cli_test
