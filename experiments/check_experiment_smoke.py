@@ -5,7 +5,8 @@
 
 Runs the sweep with --jobs 2, checks that every planned run finished with status ok and an error
 against full resolution (0 for the full run itself), that the coarsest uniform level is farther
-from full resolution than the tightest adaptive run, that the charts exist, and that a second
+from full resolution than the tightest adaptive run (and an `elastic` variant, which ignores
+plasticity, more than 10× farther), that the charts exist, and that a second
 invocation resumes: it starts no run (every run.json unchanged) and rebuilds the same table.
 """
 import csv
@@ -48,6 +49,11 @@ def main():
     tightest = min(adaptive, key=lambda row: float(row["tolerance"]))
     if not float(by_run["uniform-0"]["error"]) > float(tightest["error"]):
         fail("uniform level 0 is not farther from full resolution than the tightest adaptive run")
+    variants = [row for row in rows if row["kind"] == "variant"]
+    if "variant-elastic" in by_run and not float(by_run["variant-elastic"]["error"]) > 10 * float(
+            tightest["error"]):
+        fail("ignoring plasticity (variant-elastic) is not clearly farther from full resolution "
+             "than the tightest adaptive run")
     for chart in ("error_vs_cost.png", "adaptive_over_time.png"):
         if os.path.getsize(os.path.join(folder, chart)) < 1000:
             fail(f"{chart} missing or empty")
@@ -64,7 +70,8 @@ def main():
         again = list(csv.DictReader(f))
     if [r["error"] for r in again] != [r["error"] for r in rows]:
         fail("resumed sweep's table differs from the first")
-    print(f"check_experiment_smoke: {len(rows)} runs ok, resume ran none again")
+    print(f"check_experiment_smoke: {len(rows)} runs ok ({len(variants)} variants), resume ran "
+          "none again")
 
 
 if __name__ == "__main__":

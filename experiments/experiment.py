@@ -11,7 +11,14 @@ SPEC.json (paths relative to the spec file):
    "tolerances": [0.05, 0.02, 0.01, 0.005],           # adaptive runs, hierarchy.tolerance
    "uniform_levels": "all",                           # or a list of levels below hierarchy.levels
    "set": {"solver.duration": 0.04},                  # overrides applied to every run (optional)
-   "quick": {"set": {...}, "tolerances": [...]}}      # the short version run with --quick
+   "quick": {"set": {...}, "tolerances": [...]},      # the short version run with --quick
+   "variants": [{"name": "springs",                   # further runs compared with the full one
+                 "scene": "../scenes/other.json",     # optional: another scene (same probes
+                 "set": {...}}]}                      #   and frames), optional overrides
+
+A variant is one more run, `variant-NAME`, charted as a point of its own: another model of the
+same scene (e.g. surface springs in place of element plasticity, on a scene without a hierarchy)
+measured against the same full-resolution run.
 
 Every run uses the scene's time stepping unchanged. Per run the sweep records wall and CPU time
 (of the strata process), element evaluations, Newton and CG iterations, the largest active tets
@@ -37,6 +44,7 @@ import csv
 import hashlib
 import json
 import os
+import re
 import shlex
 import subprocess
 import sys
@@ -59,9 +67,10 @@ def load_spec(path, quick=False):
     except (OSError, json.JSONDecodeError) as error:
         fail(f"{path}: {error}")
     for key in spec:
-        if key not in ("name", "scene", "tolerances", "uniform_levels", "set", "quick"):
+        if key not in ("name", "scene", "tolerances", "uniform_levels", "set", "quick",
+                       "variants"):
             fail(f"{path}: unknown key '{key}' (valid: name, scene, tolerances, uniform_levels, "
-                 "set, quick)")
+                 "set, quick, variants)")
     if "scene" not in spec:
         fail(f"{path}: 'scene' is required")
     spec["scene"] = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)),
@@ -97,6 +106,36 @@ def load_spec(path, quick=False):
         if not isinstance(level, int) or not 0 <= level < levels:
             fail(f"{path}: uniform_levels.{i}: must be an integer in 0..{levels - 1}")
     spec["levels"] = levels
+    variants = spec.get("variants", [])
+    if not isinstance(variants, list):
+        fail(f"{path}: variants: must be an array")
+    names = set()
+    for i, variant in enumerate(variants):
+        where = f"{path}: variants.{i}"
+        if not isinstance(variant, dict):
+            fail(f"{where}: must be an object")
+        for key in variant:
+            if key not in ("name", "scene", "set"):
+                fail(f"{where}: unknown key '{key}' (valid: name, scene, set)")
+        name = variant.get("name")
+        if not isinstance(name, str) or not re.fullmatch(r"[a-z0-9_.-]+", name):
+            fail(f"{where}.name: required, letters a-z, digits, '_', '-', '.'")
+        if name in names:
+            fail(f"{where}.name: '{name}' appears twice")
+        names.add(name)
+        variant.setdefault("set", {})
+        if not isinstance(variant["set"], dict):
+            fail(f"{where}.set: must be an object of key.path: value")
+        if "scene" in variant:
+            variant["scene"] = os.path.normpath(
+                os.path.join(os.path.dirname(os.path.abspath(path)), variant["scene"]))
+            try:
+                with open(variant["scene"], "rb") as f:
+                    variant["scene_bytes"] = f.read()
+                json.loads(variant["scene_bytes"])
+            except (OSError, json.JSONDecodeError) as error:
+                fail(f"{where}.scene: {error}")
+    spec["variants"] = variants
     return spec
 
 
@@ -109,7 +148,20 @@ def planned_runs(spec):
     for tolerance in spec["tolerances"]:
         runs.append((f"adaptive-{tolerance:g}", "adaptive",
                      {"hierarchy.mode": "adaptive", "hierarchy.tolerance": tolerance}))
+    for variant in spec["variants"]:
+        settings = dict(variant["set"])
+        if "scene" in variant:
+            settings[SCENE_KEY] = variant["scene"]
+        runs.append((f"variant-{variant['name']}", "variant", settings))
     return runs
+
+
+# A run's own scene file (variants), carried among its settings.
+SCENE_KEY = "@scene"
+
+
+def scene_of(spec, settings):
+    return settings.get(SCENE_KEY, spec["scene"])
 
 
 def run_folder(args, spec, name, settings):
@@ -117,15 +169,20 @@ def run_folder(args, spec, name, settings):
     digest.update(spec["scene_bytes"])
     digest.update(json.dumps(spec["set"], sort_keys=True).encode())
     digest.update(json.dumps(settings, sort_keys=True).encode())
+    if SCENE_KEY in settings:
+        with open(settings[SCENE_KEY], "rb") as f:
+            digest.update(f.read())
     return os.path.join(args.out, spec["name"], "runs", f"{name}-{digest.hexdigest()[:12]}")
 
 
 def command_for(args, spec, folder, settings, threads):
-    command = [args.strata, "run", spec["scene"], "--out", folder, "--quiet",
+    command = [args.strata, "run", scene_of(spec, settings), "--out", folder, "--quiet",
                "--set", "output.vtk=false"]
     if threads > 0:
         command += ["--threads", str(threads)]
     for key, value in list(spec["set"].items()) + list(settings.items()):
+        if key == SCENE_KEY:
+            continue
         command += ["--set", f"{key}={json.dumps(value)}"]
     return command
 
@@ -196,6 +253,8 @@ def summarise(args, spec):
             row["level"] = settings["hierarchy.level"]
         if kind == "adaptive":
             row["tolerance"] = settings["hierarchy.tolerance"]
+        if kind == "variant":
+            row["variant"] = name[len("variant-"):]
         stats_path = os.path.join(folder, "stats.json")
         if os.path.exists(stats_path):
             with open(stats_path) as f:
@@ -247,7 +306,7 @@ def summarise(args, spec):
     return rows
 
 
-COLUMNS = ["run", "kind", "level", "tolerance", "status", "error", "energy_difference",
+COLUMNS = ["run", "kind", "level", "tolerance", "variant", "status", "error", "energy_difference",
            "estimated_error",
            "effectivity", "tolerance_met", "wall_seconds", "cpu_seconds", "speedup",
            "max_active_tets", "max_dofs", "element_evaluations", "newton_iterations",
@@ -284,6 +343,8 @@ def write_results(args, spec, rows):
                 for x, y, r in points:
                     axis.annotate(f"L{r['level']}" if kind == "uniform" else f"τ={r['tolerance']:g}",
                                   (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        for r in (r for r in ok if r["kind"] == "variant" and r.get(cost)):
+            axis.plot([r[cost]], [max(r["error"], 1e-6)], "D", label=r["variant"])
         full = next((r for r in rows if r["run"] == "full"), None)
         if full is not None and full.get(cost):
             axis.axvline(full[cost], color="k", linestyle=":", label="full resolution")

@@ -235,6 +235,28 @@ TEST(SceneParser, BadPlasticityAndLoadHistoriesNameTheKey) {
   EXPECT_EQ(parse_error(scene), "scene.json: solver.max_plastic_passes: must be >= 1");
 }
 
+TEST(SceneParser, SurfaceSprings) {
+  json scene = minimal_scene();
+  scene["material"]["surface_springs"] = {
+      {"youngs_modulus", 1e5}, {"yield_strain", 0.01}, {"fraction", 0.25}, {"seed", 4}};
+  const Scene parsed = parse_scene(scene, "scene.json");
+  ASSERT_TRUE(parsed.surface_springs.has_value());
+  EXPECT_EQ(parsed.surface_springs->youngs_modulus, 1e5);
+  EXPECT_EQ(parsed.surface_springs->yield_strain, 0.01);
+  EXPECT_EQ(parsed.surface_springs->fraction, 0.25);
+  EXPECT_EQ(parsed.surface_springs->seed, 4u);
+  EXPECT_FALSE(parse_scene(minimal_scene(), "scene.json").surface_springs.has_value());
+  scene["material"]["surface_springs"]["fraction"] = 1.5;
+  EXPECT_EQ(parse_error(scene), "scene.json: material.surface_springs.fraction: must be in (0, 1]");
+  scene["material"]["surface_springs"] = {{"yield_strain", 0.01}};
+  EXPECT_THAT(parse_error(scene), HasSubstr("material.surface_springs.youngs_modulus"));
+  scene["material"]["surface_springs"] = {{"youngs_modulus", 1e5}};
+  scene["hierarchy"] = {{"levels", 1}};
+  EXPECT_EQ(parse_error(scene),
+            "scene.json: material.surface_springs: not supported with hierarchy (the springs "
+            "live on one mesh's surface)");
+}
+
 TEST(SceneParser, UnknownEnumValuesListTheChoices) {
   json scene = minimal_scene();
   scene["solver"] = {{"mode", "dynamic"}, {"integrator", "rk5"}, {"dt", 1e-3}, {"duration", 1}};

@@ -2,6 +2,7 @@
 
 #include "strata/core/sim/energy/elastic_term.hpp"
 #include "strata/core/sim/energy/external_work_term.hpp"
+#include "strata/core/sim/energy/spring_term.hpp"
 
 namespace strata {
 
@@ -15,6 +16,7 @@ ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
   m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_inertia = &m_energy.emplace<InertiaTerm>(problem.dof_mass);
   m_energy.emplace<ElasticTerm>(problem.model);
+  if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(*problem.springs);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.mass_damping > 0.0 || problem.stiffness_damping > 0.0)
     m_damping = &m_energy.emplace<RayleighDampingTerm>(

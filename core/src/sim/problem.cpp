@@ -37,10 +37,16 @@ void Problem::add_damping_forces(const VectorXd& x, const VectorXd& v, const Vec
   f += (stiffness_damping / epsilon) * (f_shifted - f_int);
 }
 
+void Problem::internal_forces(const VectorXd& x, VectorXd& f_int) const {
+  model.forces(x, f_int);
+  if (springs != nullptr) springs->add_forces(x, f_int);
+}
+
 void Problem::accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const {
   VectorXd f_int;
-  model.forces(x, f_int);
+  model.forces(x, f_int);  // the damping's finite difference differentiates these
   VectorXd f = f_int;
+  if (springs != nullptr) springs->add_forces(x, f);
   if (has_timed_forces()) {
     VectorXd f_ext;
     external_forces_at(t, 1.0, f_ext);

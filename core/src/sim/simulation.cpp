@@ -110,6 +110,12 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   } else if (!options.plastic_state.empty()) {
     throw InputError("simulation: plastic_state given for a material without plasticity");
   }
+  if (options.surface_springs) {
+    if (!m_embedded->is_identity())
+      throw InputError("material.surface_springs: not supported on a mesh with hanging vertices");
+    m_springs =
+        std::make_unique<SurfaceSprings>(m_mesh.vertices, m_boundary, *options.surface_springs);
+  }
   m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
@@ -125,7 +131,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .ground = m_ground ? &*m_ground : nullptr,
                              .ground_stiffness = m_ground_stiffness,
                              .nested_spaces = m_nested.empty() ? nullptr : &m_nested,
-                             .timed_forces = &m_timed});
+                             .timed_forces = &m_timed,
+                             .springs = m_springs.get()});
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
   if (is_static()) {
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), load_factor(), 0.0, m_x, m_v);
@@ -200,6 +207,7 @@ void Simulation::advance() {
   if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
   update_mesh_state();
   if (is_plastic()) update_plastic_state(t0, t1, h, q_start, v_start);
+  if (m_springs) m_springs->yield(m_x);
   ++m_steps;
   check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
                    m_steps, time(), std::string(m_stepper_traits->name));
@@ -339,6 +347,7 @@ std::vector<GroupReaction> Simulation::reactions() const {
   VectorXd f_int;
   m_embedded->forces(m_x, f_int);
   VectorXd f = f_int;
+  if (m_springs) m_springs->add_forces(m_x, f);
   VectorXd mass_times_acceleration = VectorXd::Zero(m_x.size());
   if (is_static()) {
     f += current_external_forces();
@@ -375,7 +384,7 @@ double Simulation::kinetic_energy() const {
 }
 
 double Simulation::elastic_energy() const {
-  return m_embedded->energy(m_x);
+  return m_embedded->energy(m_x) + (m_springs ? m_springs->energy(m_x) : 0.0);
 }
 
 double Simulation::external_potential_energy() const {

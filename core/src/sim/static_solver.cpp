@@ -4,6 +4,7 @@
 
 #include "strata/core/sim/energy/elastic_term.hpp"
 #include "strata/core/sim/energy/ground_penalty_term.hpp"
+#include "strata/core/sim/energy/spring_term.hpp"
 
 namespace strata {
 
@@ -15,6 +16,7 @@ StaticSolver::StaticSolver(const Problem& problem, LinearSolverKind solver, Newt
       m_energy(problem.model.stiffness_pattern()) {
   m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_energy.emplace<ElasticTerm>(problem.model);
+  if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(*problem.springs);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.ground != nullptr)
     m_energy.emplace<GroundPenaltyTerm>(*problem.ground, problem.ground_stiffness);

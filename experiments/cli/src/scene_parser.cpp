@@ -155,9 +155,23 @@ Plasticity parse_plasticity(const SceneValue& value) {
   return plasticity;
 }
 
+SurfaceSpringSettings parse_surface_springs(const SceneValue& value) {
+  value.expect_object({"youngs_modulus", "yield_strain", "fraction", "seed"});
+  SurfaceSpringSettings springs;
+  springs.youngs_modulus = value.at("youngs_modulus").positive();
+  if (value.has("yield_strain")) springs.yield_strain = value.at("yield_strain").positive();
+  if (value.has("fraction")) {
+    const SceneValue fraction = value.at("fraction");
+    springs.fraction = fraction.positive();
+    if (springs.fraction > 1.0) fraction.fail("must be in (0, 1]");
+  }
+  if (value.has("seed")) springs.seed = static_cast<std::uint32_t>(value.at("seed").integer(0));
+  return springs;
+}
+
 Material parse_material(const SceneValue& value) {
-  value.expect_object(
-      {"model", "youngs_modulus", "poisson_ratio", "density", "damping", "plasticity"});
+  value.expect_object({"model", "youngs_modulus", "poisson_ratio", "density", "damping",
+                       "plasticity", "surface_springs"});
   Material material;
   const int model = value.at("model").choice({"stvk", "corotated", "neohookean"});
   material.model = static_cast<MaterialModel>(model);
@@ -293,6 +307,14 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   scene.name = file.stem().string();
   scene.mesh = parse_mesh(top.at("mesh"), file.parent_path());
   scene.material = parse_material(top.at("material"));
+  if (top.at("material").has("surface_springs")) {
+    scene.surface_springs = parse_surface_springs(top.at("material").at("surface_springs"));
+    if (top.has("hierarchy")) {
+      throw SceneKeyError(file_name, "material.surface_springs",
+                          "not supported with hierarchy (the springs live on one mesh's surface)",
+                          false);
+    }
+  }
   if (top.has("gravity")) scene.gravity = top.at("gravity").vec3();
   if (top.has("fixed")) {
     for (const SceneValue& entry : top.at("fixed").elements()) {

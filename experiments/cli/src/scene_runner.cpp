@@ -54,9 +54,11 @@ class SceneSimulation {
         m_adaptive = adaptive.get();
         m_run = std::move(adaptive);
       } else {
-        m_run =
-            std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
-                                         scene.forces, scene.ground, scene.gravity, scene.solver);
+        SimulationOptions options;
+        options.surface_springs = scene.surface_springs;
+        m_run = std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
+                                             scene.forces, scene.ground, scene.gravity,
+                                             scene.solver, std::move(options));
       }
     } catch (const InputError& error) {
       throw InputError(scene.file.string() + ": " + error.what());
@@ -197,6 +199,15 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                        {"density", scene.material.density},
                        {"mass_damping", scene.material.mass_damping},
                        {"stiffness_damping", scene.material.stiffness_damping}};
+  if (const SurfaceSprings* springs = simulation.surface_springs()) {
+    stats["surface_springs"] = {{"springs", springs->size()},
+                                {"youngs_modulus", scene.surface_springs->youngs_modulus},
+                                {"fraction", scene.surface_springs->fraction},
+                                {"yield_events", springs->yield_events()},
+                                {"largest_plastic_strain", springs->largest_plastic_strain()}};
+    if (std::isfinite(scene.surface_springs->yield_strain))
+      stats["surface_springs"]["yield_strain"] = scene.surface_springs->yield_strain;
+  }
   if (scene.material.plasticity) {
     const Plasticity& plasticity = *scene.material.plasticity;
     nlohmann::json block = {{"yield_stress", plasticity.yield_stress},

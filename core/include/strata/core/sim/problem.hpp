@@ -23,6 +23,7 @@
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/multigrid.hpp"
+#include "strata/core/sim/surface_springs.hpp"
 
 namespace strata {
 
@@ -47,6 +48,8 @@ struct Problem {
   const NestedSpaces* nested_spaces = nullptr;
   /// Loads that follow their own amplitude s_k(t) (3·#Q each); null or empty: none.
   const std::vector<TimedForces>* timed_forces = nullptr;
+  /// Surface springs on the DOF vertices (meshes without an embedding); null: none.
+  const SurfaceSprings* springs = nullptr;
 
   /// s(t) = min(t / T_r, 1).
   double ramp(double t) const;
@@ -62,6 +65,8 @@ struct Problem {
   /// Adds −(α M + β K(x)) v into `f`, K v by finite difference; `f_int` = f_int(x).
   void add_damping_forces(const VectorXd& x, const VectorXd& v, const VectorXd& f_int,
                           VectorXd& f) const;
+  /// f_int = elastic forces (+ surface spring forces), 3·#Q.
+  void internal_forces(const VectorXd& x, VectorXd& f_int) const;
   /// a = M⁻¹ (f_int + f_ext + f_damp); at Dirichlet DOFs the prescribed acceleration at time t.
   void accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const;
 };

@@ -37,6 +37,7 @@
 #include "strata/core/sim/multigrid.hpp"
 #include "strata/core/sim/simulation_run.hpp"
 #include "strata/core/sim/solver_settings.hpp"
+#include "strata/core/sim/surface_springs.hpp"
 
 namespace strata {
 
@@ -76,6 +77,9 @@ struct SimulationOptions {
   /// Plastic state per mesh tet to start from (material with plasticity only); empty: virgin
   /// material (Fₚ = I, ε̄ₚ = 0).
   PlasticState plastic_state;
+  /// Surface springs with yielding rest lengths (surface_springs.hpp) on the mesh's boundary
+  /// edges; meshes without an embedding only.
+  std::optional<SurfaceSpringSettings> surface_springs;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
@@ -161,7 +165,10 @@ class Simulation final : public SimulationRun {
 
   std::vector<GroupReaction> reactions() const;
   double kinetic_energy() const;  ///< ½ v_qᵀ M_q v_q [J]
-  double elastic_energy() const;  ///< Ψ(x) [J]
+  /// Ψ(x) [J], with the surface springs' energy if there are any.
+  double elastic_energy() const;
+  /// The surface springs, or nullptr.
+  const SurfaceSprings* surface_springs() const { return m_springs.get(); }
   /// Potential of the dead loads −s_f f_extᵀ(x − X) [J] (s_f = load factor in static mode, 1 in
   /// dynamic mode); with loads that follow amplitudes, that of the loads acting now,
   /// −f_ext(t)ᵀ(x − X).
@@ -238,6 +245,7 @@ class Simulation final : public SimulationRun {
   long m_first_step = 0;
   long m_steps = 0;
   PlasticState m_plastic;
+  std::unique_ptr<SurfaceSprings> m_springs;
   SimulationCounters m_newton;  ///< Newton and plasticity fields only
   void record_newton(const NewtonResult& result);
 };

@@ -55,6 +55,9 @@ struct Scene {
   std::string name;            ///< its stem, e.g. "cantilever"
   MeshSpec mesh;
   Material material;
+  /// "material.surface_springs": yielding springs on the surface (surface_springs.hpp); runs
+  /// without `hierarchy` only.
+  std::optional<SurfaceSpringSettings> surface_springs;
   Vector3d gravity = Vector3d::Zero();    ///< [m/s²]
   std::vector<DirichletSpec> fixed;       ///< kind fixed
   std::vector<DirichletSpec> prescribed;  ///< kind displacement or rotation (angle in radians)

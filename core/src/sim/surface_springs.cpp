@@ -1,0 +1,116 @@
+#include "strata/core/sim/surface_springs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+void validate_surface_springs(const SurfaceSpringSettings& s, const std::string& where) {
+  if (!(s.youngs_modulus > 0.0) || !std::isfinite(s.youngs_modulus))
+    throw InputError(where + ".youngs_modulus: must be positive and finite");
+  if (!(s.yield_strain > 0.0)) throw InputError(where + ".yield_strain: must be positive");
+  if (!(s.fraction > 0.0 && s.fraction <= 1.0))
+    throw InputError(where + ".fraction: must be in (0, 1]");
+}
+
+SurfaceSprings::SurfaceSprings(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX3i> boundary,
+                               const SurfaceSpringSettings& settings)
+    : m_settings(settings) {
+  validate_surface_springs(settings, "material.surface_springs");
+  std::vector<std::array<int, 2>> all;
+  for (Index f = 0; f < boundary.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = boundary(f, k), b = boundary(f, (k + 1) % 3);
+      all.push_back({std::min(a, b), std::max(a, b)});
+    }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  std::mt19937 rng(settings.seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (const auto& edge : all)
+    if (uniform(rng) < settings.fraction) m_edges.push_back(edge);
+  if (m_edges.empty() && !all.empty()) m_edges.push_back(all.front());
+  m_rest.resize(size());
+  m_stiffness.resize(size());
+  for (Index s = 0; s < size(); ++s) {
+    const auto [a, b] = m_edges[s];
+    m_rest[s] = (rest_positions.row(b) - rest_positions.row(a)).norm();
+    m_stiffness[s] = settings.youngs_modulus * m_rest[s];
+  }
+  m_initial_rest = m_rest;
+}
+
+double SurfaceSprings::energy(ConstRef<VectorXd> x) const {
+  double energy = 0.0;
+  for (Index s = 0; s < size(); ++s) {
+    const auto [a, b] = m_edges[s];
+    const double stretch = (x.segment<3>(3 * b) - x.segment<3>(3 * a)).norm() - m_rest[s];
+    energy += 0.5 * m_stiffness[s] * stretch * stretch;
+  }
+  return energy;
+}
+
+void SurfaceSprings::add_forces(ConstRef<VectorXd> x, VectorXd& f) const {
+  for (Index s = 0; s < size(); ++s) {
+    const auto [a, b] = m_edges[s];
+    const Vector3d d = x.segment<3>(3 * b) - x.segment<3>(3 * a);
+    const double length = d.norm();
+    if (length == 0.0) continue;
+    const Vector3d force = m_stiffness[s] * (length - m_rest[s]) / length * d;  // pulls b to a
+    f.segment<3>(3 * a) += force;
+    f.segment<3>(3 * b) -= force;
+  }
+}
+
+void SurfaceSprings::add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian,
+                                 bool project_psd) const {
+  for (Index s = 0; s < size(); ++s) {
+    const auto [a, b] = m_edges[s];
+    const Vector3d d = x.segment<3>(3 * b) - x.segment<3>(3 * a);
+    const double length = d.norm();
+    if (length == 0.0) continue;
+    const Vector3d n = d / length;
+    double transverse = 1.0 - m_rest[s] / length;
+    if (project_psd) transverse = std::max(transverse, 0.0);
+    const Matrix3d nn = n * n.transpose();
+    const Matrix3d K = m_stiffness[s] * (nn + transverse * (Matrix3d::Identity() - nn));
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        hessian.coeffRef(3 * a + r, 3 * a + c) += K(r, c);
+        hessian.coeffRef(3 * b + r, 3 * b + c) += K(r, c);
+        hessian.coeffRef(3 * a + r, 3 * b + c) -= K(r, c);
+        hessian.coeffRef(3 * b + r, 3 * a + c) -= K(r, c);
+      }
+  }
+}
+
+Index SurfaceSprings::yield(ConstRef<VectorXd> x) {
+  Index yielded = 0;
+  const double limit = m_settings.yield_strain;
+  for (Index s = 0; s < size(); ++s) {
+    const auto [a, b] = m_edges[s];
+    const double length = (x.segment<3>(3 * b) - x.segment<3>(3 * a)).norm();
+    const double strain = length / m_rest[s] - 1.0;
+    if (strain > limit) {
+      m_rest[s] = length / (1.0 + limit);
+      ++yielded;
+    } else if (strain < -limit) {
+      m_rest[s] = length / (1.0 - limit);
+      ++yielded;
+    }
+  }
+  m_yield_events += yielded;
+  return yielded;
+}
+
+double SurfaceSprings::largest_plastic_strain() const {
+  double largest = 0.0;
+  for (Index s = 0; s < size(); ++s)
+    largest = std::max(largest, std::abs(std::log(m_rest[s] / m_initial_rest[s])));
+  return largest;
+}
+
+}  // namespace strata
