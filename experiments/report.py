@@ -129,7 +129,7 @@ def main():
                         "slab_press_dynamic_tolerance",
                         help="comma-separated sweep names held to the 5x target")
     parser.add_argument("--stability", help="folder of a stability_map.py run to include")
-    parser.add_argument("--bending", default="cantilever_tip_poke,thin_slab_poke",
+    parser.add_argument("--bending", default="bracket_plastic,cantilever_tip_poke,thin_slab_poke",
                         help="comma-separated sweep names held to 'never slower than full'")
     args = parser.parse_args()
     if args.specs:
