@@ -6,10 +6,11 @@
 Runs the sweep with --jobs 2, checks that every planned run finished with status ok and an error
 against full resolution (0 for the full run itself), that the coarsest uniform level is farther
 from full resolution than the tightest adaptive run (and an `elastic` variant, which ignores
-plasticity, more than 10× farther), that the charts exist, and that a second
-invocation resumes: it starts no run (every run.json unchanged) and rebuilds the same table.
+plasticity, more than 10× farther), that the charts (and the spec's pictures) exist, and that a
+second invocation resumes: it starts no run (every run.json unchanged) and rebuilds the same table.
 """
 import csv
+import json
 import os
 import subprocess
 import sys
@@ -57,6 +58,10 @@ def main():
     for chart in ("error_vs_cost.png", "adaptive_over_time.png"):
         if os.path.getsize(os.path.join(folder, chart)) < 1000:
             fail(f"{chart} missing or empty")
+    with open(spec) as f:
+        wants_pictures = "pictures" in json.load(f)
+    if wants_pictures and os.path.getsize(os.path.join(folder, "pictures.png")) < 10000:
+        fail("pictures.png missing or empty")
     markers = {}
     for run in os.listdir(os.path.join(folder, "runs")):
         markers[run] = os.path.getmtime(os.path.join(folder, "runs", run, "run.json"))

@@ -51,7 +51,8 @@ import sys
 import threading
 import time
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(REPO, "experiments", "hierarchy"))
 from compare_to_full import read_probes  # noqa: E402  (probes.csv keyed by (time, probe))
 
@@ -68,9 +69,9 @@ def load_spec(path, quick=False):
         fail(f"{path}: {error}")
     for key in spec:
         if key not in ("name", "scene", "tolerances", "uniform_levels", "set", "quick",
-                       "variants"):
+                       "variants", "pictures"):
             fail(f"{path}: unknown key '{key}' (valid: name, scene, tolerances, uniform_levels, "
-                 "set, quick, variants)")
+                 "set, quick, variants, pictures)")
     if "scene" not in spec:
         fail(f"{path}: 'scene' is required")
     spec["scene"] = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)),
@@ -136,6 +137,26 @@ def load_spec(path, quick=False):
             except (OSError, json.JSONDecodeError) as error:
                 fail(f"{where}.scene: {error}")
     spec["variants"] = variants
+    pictures = spec.get("pictures")
+    if pictures is not None:
+        where = f"{path}: pictures"
+        if not isinstance(pictures, dict):
+            fail(f"{where}: must be an object")
+        for key in pictures:
+            if key not in ("run", "frames", "titles", "fields", "exaggerate", "view"):
+                fail(f"{where}: unknown key '{key}' (valid: run, frames, titles, fields, "
+                     "exaggerate, view)")
+        if pictures.get("run") not in [r[0] for r in planned_runs(spec)]:
+            fail(f"{where}.run: must name a run of the sweep (see --list)")
+        frames = pictures.setdefault("frames", [1.0])
+        if not frames or not all(isinstance(f, (int, float)) and 0 <= f <= 1 for f in frames):
+            fail(f"{where}.frames: fractions of the run in [0, 1]")
+        titles = pictures.setdefault("titles", [f"{f:g} of the run" for f in frames])
+        if len(titles) != len(frames):
+            fail(f"{where}.titles: one per frame")
+        pictures.setdefault("fields", ["von_mises"])
+        pictures.setdefault("exaggerate", 1.0)
+        pictures.setdefault("view", [22.0, -60.0])
     return spec
 
 
@@ -218,6 +239,45 @@ def execute(args, spec, name, settings, threads):
         json.dump(record, f, indent=1)
     os.replace(temporary, marker)
     return record
+
+
+def draw_pictures(args, spec):
+    """Re-runs the spec's picture run with .vtu frames (once; kept like a run) and renders them
+    into OUT/NAME/pictures.png."""
+    pictures = spec.get("pictures")
+    if not pictures:
+        return
+    name = pictures["run"]
+    settings = next(r[2] for r in planned_runs(spec) if r[0] == name)
+    folder = run_folder(args, spec, name, settings).replace(
+        os.path.join(spec["name"], "runs"), os.path.join(spec["name"], "pictures"))
+    marker = os.path.join(folder, "run.json")
+    if not os.path.exists(marker):
+        os.makedirs(folder, exist_ok=True)
+        command = command_for(args, spec, folder, settings, args.threads) + [
+            "--set", "output.vtk=true"]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            print(f"experiment: the picture run failed: {result.stderr.strip()[-300:]}",
+                  file=sys.stderr)
+            return
+        with open(marker + ".part", "w") as f:
+            json.dump({"command": command}, f)
+        os.replace(marker + ".part", marker)
+    frames = sorted(f for f in os.listdir(folder) if re.fullmatch(r".*_\d{6}\.vtu", f))
+    if not frames:
+        print("experiment: the picture run wrote no .vtu frames", file=sys.stderr)
+        return
+    chosen = [os.path.join(folder, frames[round(f * (len(frames) - 1))])
+              for f in pictures["frames"]]
+    command = [sys.executable, os.path.join(HERE, "render.py"), *chosen,
+               "--out", os.path.join(args.out, spec["name"], "pictures.png"),
+               "--fields", ",".join(pictures["fields"]),
+               "--exaggerate", str(pictures["exaggerate"]),
+               "--view", *[str(v) for v in pictures["view"]], "--titles", *pictures["titles"]]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        print(f"experiment: rendering failed: {result.stderr.strip()[-300:]}", file=sys.stderr)
 
 
 def error_against(reference, frames):
@@ -472,6 +532,8 @@ def main():
         return
     rows = summarise(args, spec)
     write_results(args, spec, rows)
+    if not args.report_only:
+        draw_pictures(args, spec)
     for row in rows:
         error = "-" if row.get("error") is None else f"{100 * row['error']:.3g} %"
         estimate = row.get("estimated_error")

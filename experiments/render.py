@@ -1,0 +1,215 @@
+#!/usr/bin/python3
+"""Pictures of strata frames: the deformed body's surface coloured by a per-cell field.
+
+  render.py FRAME.vtu [FRAME.vtu ...] --out PICTURE.png [--fields level,von_mises,...]
+            [--view ELEVATION AZIMUTH] [--titles "peak load" "unloaded" ...] [--exaggerate K]
+  render.py SERIES.pvd --gif ANIMATION.gif [--fields level] [--fps 8]
+
+One panel per frame and field (rows: frames, columns: fields). A frame is a .vtu that `strata
+run` writes (positions already deformed); its boundary triangles (the tet faces that belong to
+one tet) are drawn with the colour of their tet's value, painter-sorted by depth, with a colour
+bar per field shared by the frames. The surface .vtp frames of a bound fine surface are drawn
+the same way (point fields are averaged per triangle). Fields: any cell field of the frame —
+`level` (active tree level, integer colours), `von_mises` [Pa], `plastic_strain`, `stress` or
+`green_strain` (the first Voigt component) — or a point field (`displacement` magnitude).
+Needs /usr/bin/python3 (matplotlib, meshio, numpy; Pillow for --gif).
+"""
+import argparse
+import os
+import sys
+import xml.etree.ElementTree as ElementTree
+
+import numpy as np
+
+
+def fail(message):
+    sys.exit(f"render: {message}")
+
+
+def load(path):
+    import meshio
+    try:
+        mesh = meshio.read(path)
+    except Exception as error:  # meshio raises many types for malformed files
+        fail(f"{path}: cannot read ({error})")
+    return mesh
+
+
+def boundary(mesh):
+    """(triangles #F × 3, owning cell #F) of the mesh's surface."""
+    tets = [c.data for c in mesh.cells if c.type == "tetra"]
+    triangles = [c.data for c in mesh.cells if c.type == "triangle"]
+    if triangles:
+        faces = np.vstack(triangles)
+        return faces, np.arange(len(faces))
+    if not tets:
+        fail("the frame has neither tets nor triangles")
+    tets = np.vstack(tets)
+    local = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+    faces = tets[:, local].reshape(-1, 3)
+    owner = np.repeat(np.arange(len(tets)), 4)
+    keys = np.sort(faces, axis=1)
+    _, index, counts = np.unique(keys, axis=0, return_index=True, return_counts=True)
+    once = index[counts == 1]
+    return faces[once], owner[once]
+
+
+def values(mesh, field, faces, owner):
+    """One value per face for `field` (cell data, or point data averaged over the corners)."""
+    if field in mesh.cell_data:
+        data = np.concatenate([np.asarray(d) for d in mesh.cell_data[field]])
+        data = data.reshape(len(data), -1)
+        column = np.linalg.norm(data, axis=1) if data.shape[1] == 3 else data[:, 0]
+        return column[owner]
+    if field in mesh.point_data:
+        data = np.asarray(mesh.point_data[field]).reshape(len(mesh.points), -1)
+        column = np.linalg.norm(data, axis=1) if data.shape[1] > 1 else data[:, 0]
+        return column[faces].mean(axis=1)
+    fields = sorted(set(mesh.cell_data) | set(mesh.point_data))
+    fail(f"no field '{field}' in the frame (it has {', '.join(fields)})")
+
+
+LABELS = {"level": "active level", "von_mises": "von Mises stress [Pa]",
+          "plastic_strain": "equivalent plastic strain", "displacement": "displacement [m]",
+          "stress": "σ_xx [Pa]", "green_strain": "E_xx"}
+
+
+def positions(mesh, exaggerate):
+    """The frame's deformed positions, the displacement scaled by `exaggerate`."""
+    points = np.asarray(mesh.points, dtype=float)
+    if exaggerate != 1.0 and "displacement" in mesh.point_data:
+        u = np.asarray(mesh.point_data["displacement"], dtype=float).reshape(len(points), 3)
+        points = points + (exaggerate - 1.0) * u
+    return points
+
+
+def draw(axis, points, faces, colours, elevation, azimuth):
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    polygons = points[faces]
+    axis.add_collection3d(Poly3DCollection(polygons, facecolors=colours, edgecolors=(0, 0, 0, 0.15),
+                                           linewidths=0.2))
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    extent = np.maximum(hi - lo, 1e-3 * (hi - lo).max())
+    for setter, a, b in zip((axis.set_xlim, axis.set_ylim, axis.set_zlim), lo, lo + extent):
+        setter(a, b)
+    axis.set_box_aspect(tuple(extent), zoom=1.0)
+    axis.view_init(elev=elevation, azim=azimuth)
+    axis.set_axis_off()
+
+
+def render(frames, fields, out, titles, view, exaggerate):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    meshes = [load(f) for f in frames]
+    surfaces = [boundary(m) for m in meshes]
+    figure = plt.figure(figsize=(4.2 * len(fields), 3.4 * len(frames)))
+    for column, field in enumerate(fields):
+        per_frame = [values(m, field, f, o) for m, (f, o) in zip(meshes, surfaces)]
+        lo = min(v.min() for v in per_frame)
+        hi = max(v.max() for v in per_frame)
+        integer = field == "level"
+        if integer:
+            cmap = plt.get_cmap("viridis", int(hi - lo) + 1)
+            norm = matplotlib.colors.Normalize(lo - 0.5, hi + 0.5)
+        else:
+            cmap = plt.get_cmap("inferno")
+            norm = matplotlib.colors.Normalize(lo, hi if hi > lo else lo + 1e-30)
+        for row, (mesh, (faces, _), v) in enumerate(zip(meshes, surfaces, per_frame)):
+            axis = figure.add_subplot(len(frames), len(fields), row * len(fields) + column + 1,
+                                      projection="3d")
+            draw(axis, positions(mesh, exaggerate), faces, cmap(norm(v)), *view)
+            title = LABELS.get(field, field)
+            if titles:
+                title = f"{titles[row]}: {title}"
+            axis.set_title(title, fontsize=9)
+            mappable = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
+            bar = figure.colorbar(mappable, ax=axis, shrink=0.6, pad=0.02)
+            bar.ax.tick_params(labelsize=7)
+            if integer:
+                bar.set_ticks(range(int(lo), int(hi) + 1))
+    if exaggerate != 1.0:
+        figure.suptitle(f"displacements ×{exaggerate:g}", fontsize=9)
+    figure.tight_layout()
+    temporary = out + ".part.png"
+    figure.savefig(temporary, dpi=110)
+    plt.close(figure)
+    os.replace(temporary, out)
+
+
+def series(pvd):
+    """The .vtu frames of a .pvd in time order (part 0: the tet mesh)."""
+    try:
+        root = ElementTree.parse(pvd).getroot()
+    except (OSError, ElementTree.ParseError) as error:
+        fail(f"{pvd}: {error}")
+    entries = [(float(d.get("timestep", 0)), d.get("file")) for d in root.iter("DataSet")
+               if d.get("part", "0") == "0"]
+    folder = os.path.dirname(pvd)
+    return [(t, os.path.join(folder, f)) for t, f in sorted(entries)]
+
+
+def animate(pvd, field, out, fps, view, exaggerate):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    frames = series(pvd)
+    if not frames:
+        fail(f"{pvd}: no frames")
+    meshes = [load(f) for _, f in frames]
+    surfaces = [boundary(m) for m in meshes]
+    per_frame = [values(m, field, f, o) for m, (f, o) in zip(meshes, surfaces)]
+    lo = min(v.min() for v in per_frame)
+    hi = max(v.max() for v in per_frame)
+    cmap = plt.get_cmap("viridis" if field == "level" else "inferno")
+    norm = matplotlib.colors.Normalize(lo, hi if hi > lo else lo + 1e-30)
+    figure = plt.figure(figsize=(5, 4))
+    axis = figure.add_subplot(projection="3d")
+
+    def frame(i):
+        axis.clear()
+        draw(axis, positions(meshes[i], exaggerate), surfaces[i][0], cmap(norm(per_frame[i])),
+             *view)
+        axis.set_title(f"{LABELS.get(field, field)}, t = {frames[i][0]:.4g}", fontsize=9)
+
+    animation = FuncAnimation(figure, frame, frames=len(frames))
+    temporary = out + ".part.gif"
+    animation.save(temporary, writer=PillowWriter(fps=fps))
+    plt.close(figure)
+    os.replace(temporary, out)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("inputs", nargs="+", help=".vtu/.vtp frames, or one .pvd with --gif")
+    parser.add_argument("--out", help="PNG of the panels")
+    parser.add_argument("--gif", help="animated GIF of a .pvd series")
+    parser.add_argument("--fields", default="von_mises")
+    parser.add_argument("--titles", nargs="*")
+    parser.add_argument("--view", nargs=2, type=float, default=(22.0, -60.0),
+                        metavar=("ELEVATION", "AZIMUTH"))
+    parser.add_argument("--fps", type=int, default=8)
+    parser.add_argument("--exaggerate", type=float, default=1.0,
+                        help="scale the displacement by this factor (1: as simulated)")
+    args = parser.parse_args()
+    fields = [f for f in args.fields.split(",") if f]
+    for path in args.inputs:
+        if not os.path.exists(path):
+            fail(f"{path}: no such file")
+    if args.gif:
+        if len(args.inputs) != 1 or not args.inputs[0].endswith(".pvd"):
+            fail("--gif takes one .pvd series")
+        animate(args.inputs[0], fields[0], args.gif, args.fps, args.view, args.exaggerate)
+        print(f"render: wrote {args.gif}")
+        return
+    if not args.out:
+        fail("--out PICTURE.png (or --gif) is required")
+    if args.titles and len(args.titles) != len(args.inputs):
+        fail(f"--titles: {len(args.titles)} titles for {len(args.inputs)} frames")
+    render(args.inputs, fields, args.out, args.titles, args.view, args.exaggerate)
+    print(f"render: wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
