@@ -4,6 +4,8 @@
 #include "strata/core/sim/energy/external_work_term.hpp"
 #include "strata/core/sim/energy/spring_term.hpp"
 
+#include <cmath>
+
 namespace strata {
 
 ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
@@ -17,6 +19,9 @@ ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
   m_inertia = &m_energy.emplace<InertiaTerm>(problem.dof_mass);
   m_energy.emplace<ElasticTerm>(problem.model);
   if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(*problem.springs);
+  if (problem.has_obstacles())
+    m_contact = &m_energy.emplace<ContactTerm>(*problem.obstacles, *problem.contact_vertices,
+                                               problem.contact);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.mass_damping > 0.0 || problem.stiffness_damping > 0.0)
     m_damping = &m_energy.emplace<RayleighDampingTerm>(
@@ -41,6 +46,14 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
   VectorXd y = x_tilde;
   VectorXd v_end = v;
   sys.apply_constraints(t + h, y, v_end);
+  if (m_contact != nullptr) {
+    m_contact->set_step(x_start, t, t + h);
+    // Newton needs a start inside the barrier's domain: the start of the step if q̃ is not.
+    if (!std::isfinite(m_contact->value(y))) {
+      y = x_start;
+      sys.apply_constraints(t + h, y, v_end);
+    }
+  }
 
   VectorXd f_int;
   model.forces(y, f_int);

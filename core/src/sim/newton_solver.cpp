@@ -151,6 +151,12 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
     choice.iteration_done();
     VectorXd full_step = VectorXd::Zero(x.size());
     reduction.add_prolonged(step, full_step);
+    // A barrier term may limit the step (it stays finite up to that fraction).
+    const double alpha_max = objective.max_step(x, full_step);
+    if (alpha_max < 1.0) {
+      full_step *= alpha_max;
+      step *= alpha_max;
+    }
     const double increment = full_step.lpNorm<Eigen::Infinity>();
 
     const double slope = g.dot(step);
@@ -188,6 +194,17 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
         // iteration with the projected Hessian before judging the residual stalled.
         choice.exact_failed();
         continue;
+      }
+      // E is at round-off along Δ but ‖g‖ is not: backtrack on ‖g‖ (stiff barrier and friction
+      // terms make the full step overshoot long before E resolves the difference).
+      for (double a = 0.5; energy_is_noise && a > 1e-6 &&
+                           !(std::isfinite(trial_energy) && trial_g.norm() < result.residual);
+           a *= 0.5) {
+        alpha = a;
+        trial = x + a * full_step;
+        trial_energy = objective.value(trial);
+        objective.gradient(trial, trial_gradient);
+        trial_g = reduction.restrict_vector(trial_gradient);
       }
       if (!(std::isfinite(trial_energy) && trial_g.norm() < result.residual)) {
         // Nothing lowers E or ‖g‖: converged if the correction is at round-off level.

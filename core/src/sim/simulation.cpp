@@ -116,6 +116,26 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     m_springs =
         std::make_unique<SurfaceSprings>(m_mesh.vertices, m_boundary, *options.surface_springs);
   }
+  ContactSettings contact;
+  if (!options.obstacles.empty()) {
+    if (!m_embedded->is_identity())
+      throw InputError("obstacles: not supported on a mesh with hanging vertices");
+    m_obstacles = std::move(options.obstacles);
+    for (const Obstacle& obstacle : m_obstacles)
+      validate_obstacle(obstacle);
+    std::vector<char> on_boundary(num_vertices, 0);
+    for (Index f = 0; f < m_boundary.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        on_boundary[m_boundary(f, k)] = 1;
+    for (Index v = 0; v < num_vertices; ++v)
+      if (on_boundary[v]) m_contact_vertices.push_back(static_cast<int>(v));
+    contact.distance =
+        m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * m_diagonal;
+    contact.stiffness = m_material.youngs_modulus * m_embedded->mean_edge_length();
+    contact.friction_slip =
+        m_settings.friction_slip > 0.0 ? m_settings.friction_slip : 1e-4 * contact.distance;
+    m_contact = std::make_unique<ContactTerm>(m_obstacles, m_contact_vertices, contact);
+  }
   m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
   const double ramp_time = m_settings.ramp_time > 0.0 ? m_settings.ramp_time : m_settings.duration;
@@ -132,7 +152,10 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .ground_stiffness = m_ground_stiffness,
                              .nested_spaces = m_nested.empty() ? nullptr : &m_nested,
                              .timed_forces = &m_timed,
-                             .springs = m_springs.get()});
+                             .springs = m_springs.get(),
+                             .obstacles = &m_obstacles,
+                             .contact_vertices = &m_contact_vertices,
+                             .contact = contact});
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
   if (is_static()) {
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), load_factor(), 0.0, m_x, m_v);
@@ -141,6 +164,25 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     m_system->apply_constraints(time(), m_x, m_v);
   }
   update_mesh_state();
+  if (m_contact) {
+    const double t = is_static() ? 0.0 : time();
+    m_contact->set_step(m_x, t, t);
+    for (const Obstacle& obstacle : m_obstacles)
+      for (int v : m_contact_vertices) {
+        Vector3d gradient;
+        const double phi = obstacle.distance_at(m_x.segment<3>(3 * v), t, gradient);
+        if (!(phi > -contact.distance))
+          throw InputError(obstacle.name + ": vertex " + std::to_string(v) + " starts " +
+                           format_number(-phi) +
+                           " m inside the obstacle (more than the contact "
+                           "tolerance " +
+                           format_number(contact.distance) + " m)");
+      }
+  }
+}
+
+const ContactSettings& Simulation::contact_settings() const {
+  return m_system->contact;
 }
 
 void Simulation::update_mesh_state() {
@@ -196,7 +238,7 @@ void Simulation::advance() {
                                 : static_cast<double>(m_steps + 1) * m_settings.dt;
   const double h = is_static() ? t1 - t0 : m_settings.dt;
   VectorXd q_start, v_start;
-  if (is_plastic() && !m_stepper_traits->is_explicit) {
+  if ((is_plastic() && !m_stepper_traits->is_explicit) || has_obstacles()) {
     q_start = m_x;
     v_start = m_v;
   }
@@ -205,12 +247,28 @@ void Simulation::advance() {
   if (!result.converged)
     throw_newton_failure(std::string(m_stepper_traits->name), result.iterations, result.residual);
   if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
+  if (has_obstacles() && m_stepper_traits->is_explicit)
+    project_obstacle_contact(m_obstacles, t1, m_x, m_v, m_constrained);
   update_mesh_state();
   if (is_plastic()) update_plastic_state(t0, t1, h, q_start, v_start);
+  if (has_obstacles()) record_contact(q_start, is_static() ? 0.0 : t0, is_static() ? 0.0 : t1);
   if (m_springs) m_springs->yield(m_x);
   ++m_steps;
   check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
                    m_steps, time(), std::string(m_stepper_traits->name));
+}
+
+void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {
+  m_contact->set_step(q_start, t0, t1);
+  m_max_penetration = std::max(m_max_penetration, -m_contact->min_distance(m_x));
+  VectorXd unused = VectorXd::Zero(m_x.size());
+  m_contact_counts.push_back(m_contact->add_normal_forces(m_x, unused));
+}
+
+VectorXd Simulation::contact_forces() const {
+  VectorXd gradient = VectorXd::Zero(m_x.size());
+  if (m_contact) m_contact->add_gradient(m_x, gradient);
+  return -gradient;
 }
 
 void Simulation::set_plastic_state(PlasticState state) {
@@ -348,6 +406,7 @@ std::vector<GroupReaction> Simulation::reactions() const {
   m_embedded->forces(m_x, f_int);
   VectorXd f = f_int;
   if (m_springs) m_springs->add_forces(m_x, f);
+  if (m_contact) f += contact_forces();
   VectorXd mass_times_acceleration = VectorXd::Zero(m_x.size());
   if (is_static()) {
     f += current_external_forces();

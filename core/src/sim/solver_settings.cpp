@@ -68,6 +68,10 @@ void validate_solver_settings(const SolverSettings& s, const std::string& where)
   positive(s.newton_tolerance, "newton_tolerance");
   positive(s.contact_stiffness_factor, "contact_stiffness_factor");
   positive(s.plastic_tolerance, "plastic_tolerance");
+  if (!std::isfinite(s.contact_distance) || s.contact_distance < 0.0)
+    throw InputError(where + ".contact_distance: must be a finite number >= 0");
+  if (!std::isfinite(s.friction_slip) || s.friction_slip < 0.0)
+    throw InputError(where + ".friction_slip: must be a finite number >= 0");
   if (!std::isfinite(s.ramp_time) || s.ramp_time < 0.0)
     throw InputError(where + ".ramp_time: must be a finite number >= 0");
   if (s.load_steps < 1) throw InputError(where + ".load_steps: must be >= 1");

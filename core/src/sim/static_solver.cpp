@@ -17,6 +17,9 @@ StaticSolver::StaticSolver(const Problem& problem, LinearSolverKind solver, Newt
   m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_energy.emplace<ElasticTerm>(problem.model);
   if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(*problem.springs);
+  if (problem.has_obstacles())
+    m_contact = &m_energy.emplace<ContactTerm>(*problem.obstacles, *problem.contact_vertices,
+                                               problem.contact);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.ground != nullptr)
     m_energy.emplace<GroundPenaltyTerm>(*problem.ground, problem.ground_stiffness);
@@ -35,6 +38,10 @@ NewtonResult StaticSolver::solve(double load_factor, VectorXd& q) {
   VectorXd unused_velocity = VectorXd::Zero(q.size());
   apply_dirichlet(m_problem.groups, model.rest_positions(), lambda, lambda, 0.0, q,
                   unused_velocity);
+  if (m_contact != nullptr) {
+    m_contact->set_step(m_contact_reference.size() == q.size() ? m_contact_reference : q, 0.0, 0.0);
+    m_contact_reference.resize(0);
+  }
 
   VectorXd f_int;
   model.forces(q, f_int);

@@ -24,6 +24,13 @@ double EnergySum::value(ConstRef<VectorXd> q) const {
   return total;
 }
 
+double EnergySum::max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const {
+  double alpha = 1.0;
+  for (const auto& term : m_terms)
+    alpha = std::min(alpha, term->max_step(q, step));
+  return alpha;
+}
+
 void EnergySum::gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
   gradient.setZero(q.size());
   for (const auto& term : m_terms)

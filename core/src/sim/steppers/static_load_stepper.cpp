@@ -1,15 +1,23 @@
 #include "strata/core/sim/steppers/static_load_stepper.hpp"
 
+#include <cmath>
+
 namespace strata {
 
 StaticLoadStepper::StaticLoadStepper(const Problem& problem, const SolverSettings& settings)
-    : m_solver(
+    : m_problem(problem),
+      m_solver(
           problem, settings.linear_solver,
           {settings.max_newton_iterations, settings.newton_tolerance, settings.exact_hessian}) {}
 
 NewtonResult StaticLoadStepper::step(double, double t1, double, VectorXd& q, VectorXd& v) {
   VectorXd guess = q;
   if (m_has_previous) guess += q - m_previous;  // linear extrapolation along the load path
+  if (m_problem.has_obstacles()) {
+    m_solver.set_contact_reference(q);
+    // The barrier needs a start inside its domain: no extrapolation into an obstacle.
+    if (!std::isfinite(m_solver.energy().value(guess))) guess = q;
+  }
   const NewtonResult result = m_solver.solve(t1, guess);
   if (!result.converged) return result;
   m_previous = q;

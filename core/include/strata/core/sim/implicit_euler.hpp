@@ -42,6 +42,7 @@ class ImplicitEuler {
   ExternalWorkTerm* m_external = nullptr;
   VectorXd m_timed_external;  ///< f_ext(t + h) when loads follow amplitudes
   InertiaTerm* m_inertia = nullptr;
+  ContactTerm* m_contact = nullptr;
   RayleighDampingTerm* m_damping = nullptr;
 };
 

@@ -20,6 +20,7 @@
 #include "strata/core/common/types.hpp"
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/embedded_model.hpp"
+#include "strata/core/sim/energy/contact_term.hpp"
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/multigrid.hpp"
@@ -50,11 +51,18 @@ struct Problem {
   const std::vector<TimedForces>* timed_forces = nullptr;
   /// Surface springs on the DOF vertices (meshes without an embedding); null: none.
   const SurfaceSprings* springs = nullptr;
+  /// Rigid obstacles (energy/contact_term.hpp), the DOF vertices tested against them and the
+  /// contact settings; null or empty: none.
+  const std::vector<Obstacle>* obstacles = nullptr;
+  const std::vector<int>* contact_vertices = nullptr;
+  ContactSettings contact{};
 
   /// s(t) = min(t / T_r, 1).
   double ramp(double t) const;
   /// ds/dt: 1/T_r while ramping, 0 after.
   double ramp_rate(double t) const;
+  /// Whether there are obstacles to contact.
+  bool has_obstacles() const { return obstacles != nullptr && !obstacles->empty(); }
   /// Whether any load follows its own amplitude.
   bool has_timed_forces() const { return timed_forces != nullptr && !timed_forces->empty(); }
   /// f = base_scale · external_forces + Σ_k s_k(t) f_k (3·#Q): the external forces at time t

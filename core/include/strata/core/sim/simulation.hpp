@@ -32,9 +32,11 @@
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/divergence_check.hpp"
 #include "strata/core/sim/embedded_model.hpp"
+#include "strata/core/sim/energy/contact_term.hpp"
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/multigrid.hpp"
+#include "strata/core/sim/obstacle.hpp"
 #include "strata/core/sim/simulation_run.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 #include "strata/core/sim/surface_springs.hpp"
@@ -80,6 +82,9 @@ struct SimulationOptions {
   /// Surface springs with yielding rest lengths (surface_springs.hpp) on the mesh's boundary
   /// edges; meshes without an embedding only.
   std::optional<SurfaceSpringSettings> surface_springs;
+  /// Rigid obstacles (obstacle.hpp) the boundary vertices contact through a barrier (implicit
+  /// and static steps) or a projection (explicit steps); meshes without an embedding only.
+  std::vector<Obstacle> obstacles;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
@@ -197,6 +202,15 @@ class Simulation final : public SimulationRun {
   /// static runs, at the current time in dynamic ones.
   VectorXd current_external_forces() const;
   const DivergenceLimits& divergence_limits() const { return m_limits; }
+  /// Obstacle contact: the settings (tolerance d̂, barrier stiffness κ = E × mean edge length,
+  /// friction slip), the largest depth of a boundary vertex inside an obstacle after any step so
+  /// far [m], the vertex–obstacle pairs in contact after each step, and the contact forces the
+  /// obstacles exert now (3·#Q [N], normal and friction).
+  bool has_obstacles() const { return !m_obstacles.empty(); }
+  const ContactSettings& contact_settings() const;
+  double max_penetration() const { return m_max_penetration; }
+  const std::vector<Index>& contact_counts() const { return m_contact_counts; }
+  VectorXd contact_forces() const;
   /// Whether the material is plastic.
   bool is_plastic() const { return m_material.plasticity.has_value(); }
   /// Plastic state per mesh tet (empty unless is_plastic()).
@@ -246,6 +260,12 @@ class Simulation final : public SimulationRun {
   long m_steps = 0;
   PlasticState m_plastic;
   std::unique_ptr<SurfaceSprings> m_springs;
+  std::vector<Obstacle> m_obstacles;
+  std::vector<int> m_contact_vertices;
+  std::unique_ptr<ContactTerm> m_contact;  ///< mirrors the stepper's, lagged at the last step
+  double m_max_penetration = 0.0;
+  std::vector<Index> m_contact_counts;
+  void record_contact(const VectorXd& q_start, double t0, double t1);
   SimulationCounters m_newton;  ///< Newton and plasticity fields only
   void record_newton(const NewtonResult& result);
 };

@@ -37,6 +37,11 @@ struct SolverSettings {
   /// max_plastic_passes solves per step (then the step is kept and counted as unconverged).
   int max_plastic_passes = 25;
   double plastic_tolerance = 1e-3;
+  /// Obstacle contact (energy/contact_term.hpp): the tolerance d̂ [m], the deepest a vertex can
+  /// enter an obstacle (0: 1e-3 × the bounding-box diagonal), and the friction slip ε [m] per
+  /// step below which friction sticks (0: 1e-4 × d̂).
+  double contact_distance = 0.0;
+  double friction_slip = 0.0;
 };
 
 std::string to_string(SimulationMode mode);    ///< "dynamic" | "static"

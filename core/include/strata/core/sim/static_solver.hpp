@@ -7,6 +7,7 @@
 /// criterion: ‖∇Π‖ over the free DOFs ≤ tolerance × max(‖λ f_ext‖, ‖f_int(q₀)‖) — the applied
 /// load, or for purely prescribed motion the internal forces of the initial guess q₀.
 #include "strata/core/sim/dof_reduction.hpp"
+#include "strata/core/sim/energy/contact_term.hpp"
 #include "strata/core/sim/energy/energy_term.hpp"
 #include "strata/core/sim/energy/external_work_term.hpp"
 #include "strata/core/sim/linear_solver.hpp"
@@ -32,6 +33,10 @@ class StaticSolver {
   /// are overwritten with the targets at s = λ). `q` is updated in place.
   NewtonResult solve(double load_factor, VectorXd& q);
 
+  /// Contact: the state friction is measured from (the previous load step's); by default the
+  /// initial guess of each solve.
+  void set_contact_reference(const VectorXd& q) { m_contact_reference = q; }
+
   const EnergySum& energy() const { return m_energy; }
   const SpdSolver& linear_solver() const { return m_solver; }
 
@@ -42,6 +47,8 @@ class StaticSolver {
   NewtonControls m_controls;
   EnergySum m_energy;
   ExternalWorkTerm* m_external = nullptr;
+  ContactTerm* m_contact = nullptr;
+  VectorXd m_contact_reference;
   VectorXd m_timed_external;  ///< f_ext(λ) when loads follow amplitudes
 };
 

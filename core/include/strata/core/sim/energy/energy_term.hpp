@@ -30,6 +30,11 @@ class EnergyTerm {
   /// sum stays PSD). H has the Problem's pattern; only its values change.
   virtual void add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian,
                            bool project_psd) const = 0;
+  /// The largest α ≤ 1 for which the term is sure to stay finite along q + α Δq (a barrier's
+  /// step filter); 1 for terms defined everywhere.
+  virtual double max_step(ConstRef<VectorXd> /*q*/, ConstRef<VectorXd> /*step*/) const {
+    return 1.0;
+  }
 };
 
 /// A sum of energy terms, the objective Newton minimises. Terms are owned.
@@ -51,6 +56,8 @@ class EnergySum {
   double value(ConstRef<VectorXd> q) const;
   /// ∂E/∂q, resized to 3·#Q.
   void gradient(ConstRef<VectorXd> q, VectorXd& gradient) const;
+  /// The smallest max_step of the terms.
+  double max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const;
   /// ∂²E/∂q² in the pattern (H is set to the pattern on first use, then only its values change).
   void hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const;
 

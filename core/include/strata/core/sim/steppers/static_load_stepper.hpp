@@ -18,6 +18,7 @@ class StaticLoadStepper final : public TimeStepper {
   const EnergySum* energy() const override { return &m_solver.energy(); }
 
  private:
+  const Problem& m_problem;
   StaticSolver m_solver;
   VectorXd m_previous;  ///< the solution before the last step
   bool m_has_previous = false;

@@ -1,0 +1,83 @@
+#pragma once
+/// \file contact_term.hpp
+/// Contact with rigid obstacles (obstacle.hpp) as an energy term, the same in static load steps
+/// and backward-Euler steps (after IPC: Li et al. 2020).
+///
+/// Normal contact: the log barrier of every tested vertex against every obstacle,
+///   b(d) = −κ (d − d̂)² log(d / d̂) for 0 < d < d̂, 0 for d ≥ d̂, +∞ for d ≤ 0,
+/// on d = φ(x) + d̂, with φ the obstacle's signed distance at the end of the step and d̂ the
+/// contact tolerance: the barrier acts while a vertex is inside the obstacle (φ < 0) and grows
+/// without bound as the depth approaches d̂. b is C² where it starts acting, and Newton's line
+/// search (which backtracks from +∞) never accepts a state deeper than d̂: every tested vertex
+/// stays within the tolerance, and a body may start exactly touching an obstacle. The Hessian uses
+/// b''(d) ∇φ ∇φᵀ (φ's own curvature term is left out; exact for planes), which is PSD.
+///
+/// Friction: smoothed, lagged Coulomb. For each vertex–obstacle pair within d̂ at the start of the
+/// step (φ(x₀) < 0), the normal force λ = −b'(d₀) and a tangent basis T ⊥ ∇φ(x₀) are frozen; the
+/// tangential slip of the step u = Tᵀ(x − x₀ − v_o Δt) (v_o the obstacle's velocity) is resisted by
+/// the potential μ λ f₀(‖u‖), f₀(y) = y²/ε − y³/(3ε²) + ε/3 below the slip tolerance ε and y above
+/// it: full Coulomb force μλ once the slip exceeds ε, a stiff spring below (static friction, with
+/// a creep of at most ε per step).
+#include <vector>
+
+#include "strata/core/sim/energy/energy_term.hpp"
+#include "strata/core/sim/obstacle.hpp"
+
+namespace strata {
+
+struct ContactSettings {
+  double distance = 0.0;       ///< d̂ > 0 [m]: the tolerance, the largest possible depth
+  double stiffness = 0.0;      ///< κ > 0 [N/m]
+  double friction_slip = 0.0;  ///< ε > 0 [m]: slip per step below which friction sticks
+};
+
+class ContactTerm final : public EnergyTerm {
+ public:
+  /// `vertices`: the DOF vertices tested against every obstacle. `obstacles` must outlive the
+  /// term.
+  ContactTerm(const std::vector<Obstacle>& obstacles, std::vector<int> vertices,
+              ContactSettings settings);
+  std::string_view name() const override { return "contact"; }
+
+  /// The step from t0 (state q0, 3·#Q) to t1: obstacles are placed at t1, friction is lagged at
+  /// q0. Static runs pass t0 = t1 = 0 and the previous load step's state.
+  void set_step(ConstRef<VectorXd> q0, double t0, double t1);
+
+  double value(ConstRef<VectorXd> q) const override;
+  void add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const override;
+  /// Barrier b'' ∇φ∇φᵀ and friction T M Tᵀ blocks on each contact vertex's diagonal: PSD, so
+  /// exact and projected coincide.
+  void add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const override;
+
+  /// Step filter: φ is 1-Lipschitz, so a vertex moving by α‖Δx‖ < φ + d̂ cannot reach the depth
+  /// d̂; returns 0.9 × the largest such α over the tested vertices (at most 1).
+  double max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const override;
+  /// Adds the barrier's (normal) contact forces −∂b/∂q at the end-of-step placement into `f`;
+  /// returns the vertex–obstacle pairs in contact (φ < 0).
+  Index add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const;
+  /// Smallest φ over the tested vertices and the obstacles at the end-of-step placement (+∞
+  /// without obstacles).
+  double min_distance(ConstRef<VectorXd> q) const;
+  const ContactSettings& settings() const { return m_settings; }
+
+  /// b(d), b'(d), b''(d) of d = φ + d̂ for 0 < d < d̂ (0 beyond).
+  double barrier(double d) const;
+  double barrier_derivative(double d) const;
+  double barrier_second_derivative(double d) const;
+
+ private:
+  struct FrictionPair {
+    int vertex;
+    int obstacle;
+    double weight;  ///< μ λ [N]
+    Eigen::Matrix<double, 3, 2> basis;
+    Vector3d reference;  ///< x₀ + v_o Δt
+  };
+  const std::vector<Obstacle>& m_obstacles;
+  std::vector<int> m_vertices;
+  ContactSettings m_settings;
+  double m_time = 0.0;
+  std::vector<FrictionPair> m_friction;
+};
+
+}  // namespace strata

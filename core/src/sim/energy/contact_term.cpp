@@ -1,0 +1,177 @@
+#include "strata/core/sim/energy/contact_term.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+namespace {
+
+/// f₁(y)/y and the smoothed friction potential f₀(y) for slip y ≥ 0 and tolerance ε.
+double f1_over_y(double y, double epsilon) {
+  return y < epsilon ? 2.0 / epsilon - y / (epsilon * epsilon) : 1.0 / y;
+}
+double f0(double y, double epsilon) {
+  return y < epsilon ? y * y / epsilon - y * y * y / (3 * epsilon * epsilon) + epsilon / 3.0 : y;
+}
+
+}  // namespace
+
+ContactTerm::ContactTerm(const std::vector<Obstacle>& obstacles, std::vector<int> vertices,
+                         ContactSettings settings)
+    : m_obstacles(obstacles), m_vertices(std::move(vertices)), m_settings(settings) {
+  if (!(settings.distance > 0.0) || !(settings.stiffness > 0.0) || !(settings.friction_slip > 0.0))
+    throw InputError("contact: distance, stiffness and friction_slip must be positive");
+}
+
+double ContactTerm::barrier(double d) const {
+  const double dhat = m_settings.distance;
+  if (d >= dhat) return 0.0;
+  return -m_settings.stiffness * (d - dhat) * (d - dhat) * std::log(d / dhat);
+}
+
+double ContactTerm::barrier_derivative(double d) const {
+  const double dhat = m_settings.distance;
+  if (d >= dhat) return 0.0;
+  return -m_settings.stiffness *
+         (2.0 * (d - dhat) * std::log(d / dhat) + (d - dhat) * (d - dhat) / d);
+}
+
+double ContactTerm::barrier_second_derivative(double d) const {
+  const double dhat = m_settings.distance;
+  if (d >= dhat) return 0.0;
+  return -m_settings.stiffness *
+         (2.0 * std::log(d / dhat) + 4.0 * (d - dhat) / d - (d - dhat) * (d - dhat) / (d * d));
+}
+
+void ContactTerm::set_step(ConstRef<VectorXd> q0, double t0, double t1) {
+  m_time = t1;
+  m_friction.clear();
+  for (size_t o = 0; o < m_obstacles.size(); ++o) {
+    const Obstacle& obstacle = m_obstacles[o];
+    if (obstacle.friction == 0.0) continue;
+    for (int v : m_vertices) {
+      Vector3d gradient;
+      const Vector3d x0 = q0.segment<3>(3 * v);
+      const double d = obstacle.distance_at(x0, t0, gradient) + m_settings.distance;
+      if (!(d > 0.0) || d >= m_settings.distance || gradient.norm() == 0.0) continue;
+      const Vector3d n = gradient.normalized();
+      const Vector3d seed = std::abs(n.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
+      const Vector3d t1v = n.cross(seed).normalized();
+      FrictionPair pair;
+      pair.vertex = v;
+      pair.obstacle = static_cast<int>(o);
+      pair.weight = obstacle.friction * -barrier_derivative(d);
+      pair.basis.col(0) = t1v;
+      pair.basis.col(1) = n.cross(t1v);
+      pair.reference = x0 + (t1 - t0) * obstacle.velocity;
+      m_friction.push_back(pair);
+    }
+  }
+}
+
+double ContactTerm::value(ConstRef<VectorXd> q) const {
+  double energy = 0.0;
+  for (const Obstacle& obstacle : m_obstacles)
+    for (int v : m_vertices) {
+      Vector3d gradient;
+      const double d =
+          obstacle.distance_at(q.segment<3>(3 * v), m_time, gradient) + m_settings.distance;
+      if (!(d > 0.0)) return std::numeric_limits<double>::infinity();
+      energy += barrier(d);
+    }
+  const double epsilon = m_settings.friction_slip;
+  for (const FrictionPair& pair : m_friction) {
+    const Eigen::Vector2d u =
+        pair.basis.transpose() * (q.segment<3>(3 * pair.vertex) - pair.reference);
+    energy += pair.weight * f0(u.norm(), epsilon);
+  }
+  return energy;
+}
+
+void ContactTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
+  for (const Obstacle& obstacle : m_obstacles)
+    for (int v : m_vertices) {
+      Vector3d n;
+      const double d = obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      if (!(d > 0.0) || d >= m_settings.distance) continue;
+      gradient.segment<3>(3 * v) += barrier_derivative(d) * n;
+    }
+  const double epsilon = m_settings.friction_slip;
+  for (const FrictionPair& pair : m_friction) {
+    const Eigen::Vector2d u =
+        pair.basis.transpose() * (q.segment<3>(3 * pair.vertex) - pair.reference);
+    gradient.segment<3>(3 * pair.vertex) +=
+        pair.weight * f1_over_y(u.norm(), epsilon) * (pair.basis * u);
+  }
+}
+
+void ContactTerm::add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool) const {
+  const auto add_block = [&](int v, const Matrix3d& block) {
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r)
+        hessian.coeffRef(3 * v + r, 3 * v + c) += block(r, c);
+  };
+  for (const Obstacle& obstacle : m_obstacles)
+    for (int v : m_vertices) {
+      Vector3d n;
+      const double d = obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      if (!(d > 0.0) || d >= m_settings.distance) continue;
+      add_block(v, barrier_second_derivative(d) * n * n.transpose());
+    }
+  const double epsilon = m_settings.friction_slip;
+  for (const FrictionPair& pair : m_friction) {
+    const Eigen::Vector2d u =
+        pair.basis.transpose() * (q.segment<3>(3 * pair.vertex) - pair.reference);
+    const double y = u.norm();
+    Eigen::Matrix2d M;
+    if (y >= epsilon) {
+      M = (Eigen::Matrix2d::Identity() - u * u.transpose() / (y * y)) / y;
+    } else {
+      M = f1_over_y(y, epsilon) * Eigen::Matrix2d::Identity();
+      if (y > 0.0) M -= u * u.transpose() / (epsilon * epsilon * y);
+    }
+    add_block(pair.vertex, pair.weight * pair.basis * M * pair.basis.transpose());
+  }
+}
+
+double ContactTerm::max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const {
+  double alpha = 1.0;
+  for (const Obstacle& obstacle : m_obstacles)
+    for (int v : m_vertices) {
+      const double move = step.segment<3>(3 * v).norm();
+      if (move == 0.0) continue;
+      Vector3d n;
+      const double room =
+          obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      if (room > 0.0) alpha = std::min(alpha, 0.9 * room / move);
+    }
+  return alpha;
+}
+
+Index ContactTerm::add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const {
+  Index active = 0;
+  for (const Obstacle& obstacle : m_obstacles)
+    for (int v : m_vertices) {
+      Vector3d n;
+      const double d = obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      if (!(d > 0.0) || d >= m_settings.distance) continue;
+      f.segment<3>(3 * v) -= barrier_derivative(d) * n;
+      ++active;
+    }
+  return active;
+}
+
+double ContactTerm::min_distance(ConstRef<VectorXd> q) const {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const Obstacle& obstacle : m_obstacles)
+    for (int v : m_vertices) {
+      Vector3d n;
+      smallest = std::min(smallest, obstacle.distance_at(q.segment<3>(3 * v), m_time, n));
+    }
+  return smallest;
+}
+
+}  // namespace strata

@@ -1,0 +1,56 @@
+#include "strata/core/sim/obstacle.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+Obstacle plane_obstacle(const std::string& name, const Vector3d& point, const Vector3d& normal) {
+  if (!point.allFinite() || !normal.allFinite() || normal.norm() == 0.0)
+    throw InputError(name + ": plane needs a finite point and a finite non-zero normal");
+  const Vector3d n = normal.normalized();
+  Obstacle obstacle;
+  obstacle.name = name;
+  obstacle.distance = [point, n](const Vector3d& p, Vector3d& gradient) {
+    gradient = n;
+    return n.dot(p - point);
+  };
+  return obstacle;
+}
+
+void validate_obstacle(const Obstacle& obstacle) {
+  if (!obstacle.distance) throw InputError(obstacle.name + ": no distance function");
+  if (!(obstacle.friction >= 0.0) || !std::isfinite(obstacle.friction))
+    throw InputError(obstacle.name + ".friction: must be >= 0");
+  if (!obstacle.velocity.allFinite())
+    throw InputError(obstacle.name + ".motion.velocity: must be finite");
+}
+
+Index project_obstacle_contact(const std::vector<Obstacle>& obstacles, double t, VectorXd& x,
+                               VectorXd& v, const std::vector<char>& skip) {
+  Index contacts = 0;
+  for (const Obstacle& obstacle : obstacles) {
+    for (Index i = 0; i < x.size() / 3; ++i) {
+      if (!skip.empty() && skip[3 * i]) continue;
+      Vector3d gradient;
+      const double phi = obstacle.distance_at(x.segment<3>(3 * i), t, gradient);
+      if (!(phi < 0.0) || gradient.norm() == 0.0) continue;
+      ++contacts;
+      const Vector3d n = gradient.normalized();
+      x.segment<3>(3 * i) -= phi * n;
+      const Vector3d relative = v.segment<3>(3 * i) - obstacle.velocity;
+      const double v_n = n.dot(relative);
+      const double dv_n = std::max(0.0, -v_n);
+      const Vector3d v_t = relative - v_n * n;
+      const double speed_t = v_t.norm();
+      const double reduced = std::max(0.0, speed_t - obstacle.friction * dv_n);
+      const Vector3d new_t = speed_t > 0.0 ? Vector3d(v_t * (reduced / speed_t)) : Vector3d::Zero();
+      v.segment<3>(3 * i) = obstacle.velocity + new_t + std::max(v_n, 0.0) * n;
+    }
+  }
+  return contacts;
+}
+
+}  // namespace strata

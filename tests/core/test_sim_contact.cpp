@@ -1,0 +1,260 @@
+// Obstacle contact (energy/contact_term.hpp, obstacle.hpp): the barrier and friction against
+// finite differences, and scenes against closed forms — a block pressed onto a plane carries the
+// load, a block on a slope sticks below the friction angle and slides with
+// a = g (sin θ − μ cos θ) above it, a block dropped on a sphere never gets deeper than the
+// tolerance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "strata/core/common/error.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/energy/contact_term.hpp"
+#include "strata/core/sim/simulation.hpp"
+
+namespace strata {
+namespace {
+
+Obstacle sphere_obstacle(const Vector3d& center, double radius, double friction = 0.0) {
+  Obstacle obstacle;
+  obstacle.name = "sphere";
+  obstacle.friction = friction;
+  obstacle.distance = [center, radius](const Vector3d& p, Vector3d& gradient) {
+    const Vector3d r = p - center;
+    gradient = r.normalized();
+    return r.norm() - radius;
+  };
+  return obstacle;
+}
+
+TEST(ContactBarrier, DerivativesMatchFiniteDifferences) {
+  std::vector<Obstacle> none;
+  const ContactTerm term(none, {}, {0.01, 3.0, 1e-4});
+  EXPECT_EQ(term.barrier(0.01), 0.0);
+  EXPECT_EQ(term.barrier_derivative(0.02), 0.0);
+  for (double d : {1e-4, 1e-3, 5e-3, 9.9e-3}) {
+    const double h = 1e-9;
+    EXPECT_NEAR(term.barrier_derivative(d), (term.barrier(d + h) - term.barrier(d - h)) / (2 * h),
+                1e-5 * std::abs(term.barrier_derivative(d)) + 1e-9);
+    EXPECT_NEAR(term.barrier_second_derivative(d),
+                (term.barrier_derivative(d + h) - term.barrier_derivative(d - h)) / (2 * h),
+                1e-5 * term.barrier_second_derivative(d) + 1e-6);
+    EXPECT_GT(term.barrier(d), 0.0);
+    EXPECT_LT(term.barrier_derivative(d), 0.0);
+    EXPECT_GT(term.barrier_second_derivative(d), 0.0);
+  }
+}
+
+TEST(ContactTermDerivatives, GradientAndHessianOfBarrierAndFriction) {
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.2, 0.1), {2, 2, 1});
+  std::vector<Obstacle> obstacles = {
+      plane_obstacle("plane", Vector3d(0, 0, 0.004), Vector3d::UnitZ()),
+      sphere_obstacle(Vector3d(0.1, 0.1, 0.105 + 0.05), 0.05, 0.4)};
+  obstacles[0].friction = 0.6;
+  std::vector<int> vertices(mesh.vertices.rows());
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    vertices[v] = static_cast<int>(v);
+  ContactTerm term(obstacles, vertices, {0.01, 50.0, 1e-3});
+  const VectorXd x0 = flatten(mesh.vertices);
+  term.set_step(x0, 0.0, 0.0);
+  VectorXd x = x0;
+  for (Index i = 0; i < x.size(); ++i)
+    x[i] += 1e-3 * std::sin(3.0 * static_cast<double>(i));
+  ASSERT_TRUE(std::isfinite(term.value(x)));
+  VectorXd g = VectorXd::Zero(x.size());
+  term.add_gradient(x, g);
+  ASSERT_GT(g.norm(), 0.0);
+  const double h = 1e-7;
+  for (Index i = 0; i < x.size(); ++i) {
+    VectorXd xp = x, xm = x;
+    xp[i] += h;
+    xm[i] -= h;
+    const double fd = (term.value(xp) - term.value(xm)) / (2 * h);
+    EXPECT_NEAR(g[i], fd, 1e-5 * g.cwiseAbs().maxCoeff()) << i;
+  }
+  ElasticModel model(mesh.vertices, mesh.tets, Material{});
+  SparseMatrixd H = model.stiffness_pattern();
+  term.add_hessian(x, H, false);
+  const Eigen::MatrixXd dense(H);
+  for (Index j = 0; j < x.size(); ++j) {
+    VectorXd xp = x, xm = x;
+    xp[j] += h;
+    xm[j] -= h;
+    VectorXd gp = VectorXd::Zero(x.size()), gm = VectorXd::Zero(x.size());
+    term.add_gradient(xp, gp);
+    term.add_gradient(xm, gm);
+    const VectorXd column = (gp - gm) / (2 * h);
+    // The sphere's curvature term b'∇²φ is left out of the Hessian; only the plane's vertices
+    // (below the sphere's reach) are compared exactly.
+    if (x[j - j % 3 + 2] < 0.02)
+      EXPECT_LE((dense.col(j) - column).norm(), 1e-4 * (column.norm() + 1e-3)) << j;
+  }
+  // Beyond the tolerance the barrier is infinite.
+  VectorXd deep = x0;
+  deep[2] = -0.02;
+  EXPECT_TRUE(std::isinf(term.value(deep)));
+}
+
+/// A 0.1 m cube (2³ cells) standing on the plane z = 0.
+TetMesh cube() {
+  return box_tet_mesh(Vector3d::Zero(), Vector3d(0.1, 0.1, 0.1), {2, 2, 2});
+}
+
+Material rubber() {
+  Material material;
+  material.model = MaterialModel::neohookean;
+  material.youngs_modulus = 1e6;
+  material.poisson_ratio = 0.3;
+  material.density = 1000.0;
+  return material;
+}
+
+TEST(ContactScenes, BlockPressedOntoAPlaneCarriesTheLoad) {
+  DirichletSpec roller;
+  roller.name = "roller";
+  roller.region = PlaneRegion{Vector3d(0, 0, 0.1), Vector3d::UnitZ(), 0.0};
+  roller.components = {true, true, false};
+  const double load = 2000.0;  // 0.2 MPa on the top face: 2 % strain
+  RegionLoad press{"press", PlaneRegion{Vector3d(0, 0, 0.1), Vector3d::UnitZ(), 0.0},
+                   Vector3d(0, 0, -load)};
+  SolverSettings settings;
+  settings.mode = SimulationMode::static_equilibrium;
+  settings.load_steps = 4;
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+  Simulation sim(cube(), rubber(), {roller}, {press}, std::nullopt, Vector3d::Zero(), settings,
+                 std::move(options));
+  while (!sim.finished())
+    sim.advance();
+  const VectorXd f = sim.contact_forces();
+  Vector3d total = Vector3d::Zero();
+  for (Index v = 0; v < f.size() / 3; ++v)
+    total += f.segment<3>(3 * v);
+  EXPECT_NEAR(total.z(), load, 1e-6 * load);
+  EXPECT_NEAR(total.head<2>().norm(), 0.0, 1e-6 * load);
+  EXPECT_GT(sim.max_penetration(), 0.0);
+  EXPECT_LE(sim.max_penetration(), sim.contact_settings().distance);
+  EXPECT_EQ(sim.contact_counts().size(), 4u);
+  EXPECT_EQ(sim.contact_counts().back(), 9);  // the 3 × 3 bottom vertices
+}
+
+struct SlopeRun {
+  double drift = 0.0;         ///< largest |Δx| of the centre of mass along the slope [m]
+  double acceleration = 0.0;  ///< centre-of-mass acceleration along the slope, 0.15–0.35 s
+  double max_penetration = 0.0;
+  double tolerance = 0.0;
+};
+
+/// The cube on the plane z = 0 with μ = 0.5 (friction angle 26.6°) under gravity tilted by θ
+/// towards +x, backward Euler for 0.35 s.
+SlopeRun slope(double degrees) {
+  const double theta = degrees * std::numbers::pi / 180.0;
+  const double g = 9.81;
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+  options.obstacles[0].friction = 0.5;
+  SolverSettings settings;
+  settings.dt = 1e-3;
+  settings.duration = 0.35;
+  const TetMesh mesh = cube();
+  Simulation sim(mesh, rubber(), {}, {}, std::nullopt,
+                 Vector3d(g * std::sin(theta), 0, -g * std::cos(theta)), settings,
+                 std::move(options));
+  const VectorXd& m = sim.vertex_mass();
+  const auto centre = [&](const VectorXd& values) {
+    Vector3d sum = Vector3d::Zero();
+    for (Index v = 0; v < m.size(); ++v)
+      sum += m[v] * values.segment<3>(3 * v);
+    return Vector3d(sum / m.sum());
+  };
+  const Vector3d start = centre(sim.positions());
+  SlopeRun run;
+  double v1 = 0.0, t1 = 0.0;
+  while (!sim.finished()) {
+    sim.advance();
+    run.drift = std::max(run.drift, std::abs(centre(sim.positions()).x() - start.x()));
+    if (std::abs(sim.time() - 0.15) < 1e-9) {
+      v1 = centre(sim.velocities()).x();
+      t1 = sim.time();
+    }
+  }
+  run.acceleration = (centre(sim.velocities()).x() - v1) / (sim.time() - t1);
+  run.max_penetration = sim.max_penetration();
+  run.tolerance = sim.contact_settings().distance;
+  return run;
+}
+
+TEST(ContactScenes, BlockOnASlopeSticksBelowTheFrictionAngle) {
+  const SlopeRun run = slope(15.0);
+  EXPECT_LT(run.drift, run.tolerance);
+  EXPECT_LE(run.max_penetration, run.tolerance);
+}
+
+TEST(ContactScenes, BlockOnASlopeSlidesWithTheCoulombAcceleration) {
+  const double theta = 35.0 * std::numbers::pi / 180.0;
+  const double expected = 9.81 * (std::sin(theta) - 0.5 * std::cos(theta));
+  const SlopeRun run = slope(35.0);
+  EXPECT_NEAR(run.acceleration, expected, 0.02 * expected);
+  EXPECT_LE(run.max_penetration, run.tolerance);
+}
+
+TEST(ContactScenes, BlockDroppedOnASphereStaysWithinTheTolerance) {
+  const TetMesh mesh =
+      box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {2, 2, 2});
+  SimulationOptions options;
+  options.obstacles = {sphere_obstacle(Vector3d::Zero(), 0.2)};
+  SolverSettings settings;
+  settings.dt = 1e-3;
+  settings.duration = 0.4;
+  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings,
+                 std::move(options));
+  double lowest = 1.0;
+  while (!sim.finished()) {
+    sim.advance();
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      lowest = std::min(lowest, sim.positions().segment<3>(3 * v).norm() - 0.2);
+  }
+  EXPECT_GT(sim.max_penetration(), 0.0);  // it landed
+  EXPECT_LE(sim.max_penetration(), sim.contact_settings().distance);
+  EXPECT_GE(lowest, -sim.contact_settings().distance);
+  EXPECT_GT(*std::max_element(sim.contact_counts().begin(), sim.contact_counts().end()), 0);
+}
+
+TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+  SolverSettings settings;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.dt = 2e-5;
+  settings.duration = 0.02;
+  TetMesh mesh = cube();
+  mesh.vertices.col(2).array() += 0.001;
+  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings,
+                 std::move(options));
+  VectorXd v = VectorXd::Zero(sim.dof_velocities().size());
+  for (Index i = 2; i < v.size(); i += 3)
+    v[i] = -0.5;
+  sim.set_state(sim.dof_positions(), v);
+  while (!sim.finished())
+    sim.advance();
+  for (Index i = 2; i < sim.positions().size(); i += 3)
+    EXPECT_GE(sim.positions()[i], -1e-12);
+}
+
+TEST(ContactScenes, StartingInsideAnObstacleIsAnError) {
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("obstacles.0", Vector3d(0, 0, 0.05), Vector3d::UnitZ())};
+  SolverSettings settings;
+  try {
+    Simulation sim(cube(), rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
+                   std::move(options));
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("obstacles.0: vertex"), std::string::npos)
+        << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace strata
