@@ -219,7 +219,7 @@ DirichletSpec parse_prescribed(const SceneValue& value) {
 SolverSettings parse_solver(const SceneValue& value) {
   value.expect_object({"mode", "integrator", "dt", "duration", "load_steps", "linear_solver",
                        "newton_tolerance", "max_newton_iterations", "hessian", "max_plastic_passes",
-                       "plastic_tolerance"});
+                       "plastic_tolerance", "contact_distance", "friction_slip"});
   SolverSettings solver;
   solver.mode = static_cast<SimulationMode>(value.at("mode").choice({"dynamic", "static"}));
   if (value.has("integrator")) {
@@ -252,7 +252,47 @@ SolverSettings parse_solver(const SceneValue& value) {
   if (value.has("plastic_tolerance")) {
     solver.plastic_tolerance = value.at("plastic_tolerance").positive();
   }
+  if (value.has("contact_distance")) {
+    solver.contact_distance = value.at("contact_distance").positive();
+  }
+  if (value.has("friction_slip")) solver.friction_slip = value.at("friction_slip").positive();
   return solver;
+}
+
+ObstacleSpec parse_obstacle(const SceneValue& value, const std::filesystem::path& folder) {
+  value.expect_object(
+      {"plane", "implicit", "level_set", "grid", "surface", "voxel_size", "friction", "motion"});
+  const int kinds =
+      value.has("plane") + value.has("implicit") + value.has("level_set") + value.has("surface");
+  if (kinds != 1) value.fail("must have exactly one of plane, implicit, level_set, surface");
+  ObstacleSpec spec;
+  spec.name = value.path();
+  if (value.has("plane")) {
+    const SceneValue plane = value.at("plane");
+    plane.expect_object({"point", "normal"});
+    spec.plane_point = plane.at("point").vec3();
+    spec.plane_normal = plane.at("normal").nonzero_vec3();
+  }
+  if (value.has("implicit")) spec.implicit = detail::parse_implicit_shape(value.at("implicit"));
+  if (value.has("level_set")) spec.level_set = parse_path(value.at("level_set"), folder);
+  if (value.has("surface")) spec.surface = parse_path(value.at("surface"), folder);
+  if (value.has("grid")) {
+    if (!value.has("level_set")) value.at("grid").fail("only allowed with level_set");
+    spec.grid = value.at("grid").string();
+  }
+  if (value.has("voxel_size")) {
+    if (!value.has("implicit") && !value.has("surface")) {
+      value.at("voxel_size").fail("only allowed with implicit or surface");
+    }
+    spec.voxel_size = value.at("voxel_size").positive();
+  }
+  if (value.has("friction")) spec.friction = value.at("friction").non_negative();
+  if (value.has("motion")) {
+    const SceneValue motion = value.at("motion");
+    motion.expect_object({"velocity"});
+    spec.velocity = motion.at("velocity").vec3();
+  }
+  return spec;
 }
 
 OutputSpec parse_output(const SceneValue& value) {
@@ -301,7 +341,7 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   const std::string file_name = file.string();
   const SceneValue top(root, "", file_name);
   top.expect_object({"mesh", "material", "gravity", "fixed", "prescribed", "forces", "ground",
-                     "solver", "output", "hierarchy"});
+                     "obstacles", "solver", "output", "hierarchy"});
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();
@@ -346,6 +386,15 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     spec.normal = ground.at("normal").nonzero_vec3().normalized();
     if (ground.has("friction")) spec.friction = ground.at("friction").non_negative();
     scene.ground = spec;
+  }
+  if (top.has("obstacles")) {
+    for (const SceneValue& entry : top.at("obstacles").elements()) {
+      scene.obstacles.push_back(parse_obstacle(entry, file.parent_path()));
+    }
+    if (top.has("hierarchy") && !scene.obstacles.empty()) {
+      throw SceneKeyError(file_name, "obstacles",
+                          "not supported with hierarchy yet (contact runs on one mesh)", false);
+    }
   }
   scene.solver = parse_solver(top.at("solver"));
   if (top.has("output")) scene.output = parse_output(top.at("output"));

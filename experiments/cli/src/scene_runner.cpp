@@ -20,6 +20,8 @@
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
+#include "strata/meshing/implicit_shape.hpp"
+#include "strata/meshing/level_set_obstacle.hpp"
 #include "strata/meshing/surface_io.hpp"
 
 namespace strata::app {
@@ -36,6 +38,38 @@ bool is_explicit(const SolverSettings& settings) {
 long planned_steps(const SolverSettings& settings) {
   if (settings.mode == SimulationMode::static_equilibrium) return settings.load_steps;
   return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
+}
+
+/// The scene's obstacles: planes in closed form, the others as level sets (implicit shapes and
+/// surfaces voxelised at `voxel_size`, default half the mesh's mean edge length).
+std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
+  std::vector<Obstacle> obstacles;
+  double mean_edge = 0.0;
+  for (Index t = 0; t < mesh.tets.rows(); ++t)
+    mean_edge += (mesh.vertices.row(mesh.tets(t, 1)) - mesh.vertices.row(mesh.tets(t, 0))).norm();
+  mean_edge /= std::max<Index>(1, mesh.tets.rows());
+  for (const ObstacleSpec& spec : scene.obstacles) {
+    Obstacle obstacle;
+    LevelSetOptions options;
+    options.voxel_size = spec.voxel_size > 0.0 ? spec.voxel_size : 0.5 * mean_edge;
+    if (spec.plane_point) {
+      obstacle = plane_obstacle(spec.name, *spec.plane_point, *spec.plane_normal);
+    } else if (spec.implicit) {
+      obstacle = level_set_obstacle(
+          spec.name, std::make_shared<LevelSet>(implicit_shape_level_set(*spec.implicit, options)));
+    } else if (spec.level_set) {
+      obstacle = level_set_obstacle(
+          spec.name, std::make_shared<LevelSet>(LevelSet::read_vdb(*spec.level_set, spec.grid)));
+    } else {
+      SurfaceLevelSet converted = surface_to_level_set(read_surface(*spec.surface), options);
+      obstacle =
+          level_set_obstacle(spec.name, std::make_shared<LevelSet>(std::move(converted.level_set)));
+    }
+    obstacle.friction = spec.friction;
+    obstacle.velocity = spec.velocity;
+    obstacles.push_back(std::move(obstacle));
+  }
+  return obstacles;
 }
 
 /// The scene's run (SimulationRun): a plain Simulation on the mesh, or (scene key "hierarchy") an
@@ -56,6 +90,7 @@ class SceneSimulation {
       } else {
         SimulationOptions options;
         options.surface_springs = scene.surface_springs;
+        options.obstacles = build_obstacles(scene, mesh);
         m_run = std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
                                              scene.forces, scene.ground, scene.gravity,
                                              scene.solver, std::move(options));
@@ -207,6 +242,14 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                                 {"largest_plastic_strain", springs->largest_plastic_strain()}};
     if (std::isfinite(scene.surface_springs->yield_strain))
       stats["surface_springs"]["yield_strain"] = scene.surface_springs->yield_strain;
+  }
+  if (simulation.has_obstacles()) {
+    const ContactSettings& contact = simulation.contact_settings();
+    stats["contact"] = {{"max_penetration", simulation.max_penetration()},
+                        {"tolerance", contact.distance},
+                        {"barrier_stiffness", contact.stiffness},
+                        {"friction_slip", contact.friction_slip},
+                        {"active_contacts", simulation.contact_counts()}};
   }
   if (scene.material.plasticity) {
     const Plasticity& plasticity = *scene.material.plasticity;

@@ -40,6 +40,9 @@ void VtkSeries::write_frame(double time, const Simulation& simulation, const Vec
   fields.add_cell_data("green_strain", Eigen::MatrixXd(tet_fields.green_strain));
   fields.add_cell_data("stress", Eigen::MatrixXd(tet_fields.cauchy_stress));
   fields.add_cell_data("von_mises", Eigen::MatrixXd(tet_fields.von_mises));
+  if (simulation.has_obstacles()) {
+    fields.add_point_data("contact_force", Eigen::MatrixXd(unflatten(simulation.contact_forces())));
+  }
   if (simulation.is_plastic()) {
     fields.add_cell_data("plastic_strain",
                          Eigen::MatrixXd(simulation.plastic_state().equivalent_strain));

@@ -41,6 +41,20 @@ struct MeshSpec {
   std::array<int, 3> box_cells{1, 1, 1};  ///< hexahedral cells per axis (6 tets each)
 };
 
+/// One entry of "obstacles": a rigid body the boundary vertices contact (obstacle.hpp); exactly
+/// one of plane, implicit, level_set, surface.
+struct ObstacleSpec {
+  std::string name;  ///< its key path, "obstacles.0"
+  std::optional<Vector3d> plane_point, plane_normal;
+  std::optional<ImplicitShape> implicit;
+  std::optional<std::filesystem::path> level_set;  ///< .vdb
+  std::string grid;                                ///< grid of `level_set`; empty: the first
+  std::optional<std::filesystem::path> surface;    ///< closed surface turned into a level set
+  double voxel_size = 0.0;  ///< implicit / surface voxels [m]; 0: half the mesh's mean edge
+  double friction = 0.0;
+  Vector3d velocity = Vector3d::Zero();  ///< "motion": {"velocity"} [m/s]
+};
+
 /// "output".
 struct OutputSpec {
   int every = 1;                 ///< write a frame every this many steps (and after the last)
@@ -68,6 +82,7 @@ struct Scene {
   /// "hierarchy": run on an active cut of a refinement tree over the mesh (full, uniform or
   /// adaptive); absent: the mesh itself, as a plain Simulation.
   std::optional<HierarchySettings> hierarchy;
+  std::vector<ObstacleSpec> obstacles;
 
   /// fixed groups first, then prescribed ones: the order of reactions.csv's `group` column.
   std::vector<DirichletSpec> dirichlet_groups() const;

@@ -1,0 +1,108 @@
+// End-to-end: obstacles from the scene file — a block dropped on an implicit sphere (a level set)
+// stays within the contact tolerance and reports its contacts; a block pressed onto a plane
+// obstacle carries the load; bad obstacle keys name their path.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cli_test_utils.hpp"
+
+namespace strata::cli_test {
+namespace {
+
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+json drop_scene() {
+  return json::parse(R"({
+    "mesh": {"box": {"min": [-0.05, -0.05, 0.22], "max": [0.05, 0.05, 0.32], "cells": [2, 2, 2]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e6, "poisson_ratio": 0.3,
+                 "density": 1000},
+    "gravity": [0, 0, -9.81],
+    "obstacles": [{"implicit": {"sphere": {"center": [0, 0, 0], "radius": 0.2}},
+                   "voxel_size": 0.005, "friction": 0.3}],
+    "solver": {"mode": "dynamic", "dt": 0.001, "duration": 0.3},
+    "output": {"every": 50, "probes": [[0, 0, 0.22]]}
+  })");
+}
+
+TEST(CliContact, BlockDroppedOnASphereStaysWithinTheTolerance) {
+  TempFolder folder;
+  write_text(folder.path() / "drop.json", drop_scene().dump(2));
+  const CliResult result = run_strata("run drop.json --quiet", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json stats = read_json(folder.path() / "out" / "drop" / "stats.json");
+  ASSERT_TRUE(stats.contains("contact"));
+  const double tolerance = stats["contact"]["tolerance"];
+  EXPECT_NEAR(tolerance, 1e-3 * std::sqrt(3 * 0.01), 1e-12);  // 1e-3 × the block's diagonal
+  EXPECT_GT(stats["contact"]["max_penetration"].get<double>(), 0.0);
+  EXPECT_LE(stats["contact"]["max_penetration"].get<double>(), tolerance);
+  EXPECT_EQ(stats["contact"]["active_contacts"].size(), 300u);
+  EXPECT_GT(stats["contact"]["active_contacts"].back().get<int>(), 0);
+  // The bottom centre rests on the sphere's top (z = 0.2), within the tolerance and the
+  // level set's trilinear error.
+  const Csv probes = read_csv(folder.path() / "out" / "drop" / "probes.csv");
+  const double z = 0.22 + probes.rows.back()[7];
+  EXPECT_NEAR(z, 0.2, tolerance + 1e-3);
+  const std::string frame = read_text(folder.path() / "out" / "drop" / "drop_000006.vtu");
+  EXPECT_THAT(frame, HasSubstr("Name=\"contact_force\""));
+}
+
+TEST(CliContact, PlaneObstacleCarriesTheLoadInStatics) {
+  TempFolder folder;
+  json scene = json::parse(R"({
+    "mesh": {"box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1], "cells": [2, 2, 2]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e6, "poisson_ratio": 0.3,
+                 "density": 1000},
+    "prescribed": [{"region": {"plane": {"point": [0, 0, 0.1], "normal": [0, 0, 1]}},
+                    "displacement": [0, 0, -0.002]}],
+    "obstacles": [{"plane": {"point": [0, 0, 0], "normal": [0, 0, 1]}}],
+    "solver": {"mode": "static", "load_steps": 2},
+    "output": {"vtk": false}
+  })");
+  write_text(folder.path() / "press.json", scene.dump(2));
+  const CliResult result = run_strata("run press.json --quiet", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const Csv reactions = read_csv(folder.path() / "out" / "press" / "reactions.csv");
+  const double pushed = reactions.rows.back()[4];  // fz of the prescribed top
+  // 2 % compression of a laterally free block: about E · 0.02 · A = 200 N, pushing down.
+  EXPECT_LT(pushed, -150.0);
+  EXPECT_GT(pushed, -300.0);
+  const json stats = read_json(folder.path() / "out" / "press" / "stats.json");
+  EXPECT_LE(stats["contact"]["max_penetration"].get<double>(),
+            stats["contact"]["tolerance"].get<double>());
+}
+
+TEST(CliContact, BadObstaclesNameTheirKey) {
+  TempFolder folder;
+  json scene = drop_scene();
+  scene["obstacles"][0]["plane"] = {{"point", {0, 0, 0}}, {"normal", {0, 0, 1}}};
+  write_text(folder.path() / "two.json", scene.dump(2));
+  CliResult result = run_strata("run two.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(
+      result.err,
+      HasSubstr("obstacles.0: must have exactly one of plane, implicit, level_set, surface"));
+  scene = drop_scene();
+  scene["obstacles"][0]["friction"] = -1;
+  write_text(folder.path() / "friction.json", scene.dump(2));
+  result = run_strata("run friction.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("obstacles.0.friction: must be >= 0"));
+  scene = drop_scene();
+  scene["obstacles"][0]["implicit"]["sphere"]["radius"] = 0.3;  // the block starts inside
+  write_text(folder.path() / "inside.json", scene.dump(2));
+  result = run_strata("run inside.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("obstacles.0: vertex"));
+  scene = drop_scene();
+  scene["hierarchy"] = {{"levels", 1}};
+  write_text(folder.path() / "tree.json", scene.dump(2));
+  result = run_strata("run tree.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("obstacles: not supported with hierarchy yet"));
+}
+
+}  // namespace
+}  // namespace strata::cli_test
