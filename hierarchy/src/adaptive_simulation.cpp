@@ -120,13 +120,15 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
                                        std::vector<DirichletSpec> dirichlet,
                                        const std::vector<RegionLoad>& loads,
                                        std::optional<GroundPlane> ground, const Vector3d& gravity,
-                                       const SolverSettings& settings)
+                                       const SolverSettings& settings,
+                                       std::vector<Obstacle> obstacles)
     : m_settings(hierarchy),
       m_material(material),
       m_dirichlet(std::move(dirichlet)),
       m_ground(std::move(ground)),
       m_gravity(gravity),
-      m_solver(settings) {
+      m_solver(settings),
+      m_obstacles(std::move(obstacles)) {
   validate_hierarchy_settings(m_settings, "hierarchy");
   validate_material(m_material, "material");
   validate_solver_settings(m_solver, "solver");
@@ -197,6 +199,7 @@ void AdaptiveSimulation::initial_adaptation() {
     options.extra_mesh_forces =
         m_mesh_external - gravity_forces(m_simulation->vertex_mass(), m_gravity);
     options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
+    options.obstacles = m_obstacles;
     std::unique_ptr<Simulation> solve;
     try {
       solve = std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet,
@@ -279,6 +282,7 @@ void AdaptiveSimulation::rebuild(long first_step) {
   options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads, &m_load_traction);
   options.first_step = first_step;
   options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
+  options.obstacles = m_obstacles;
   m_mesh_external = options.extra_mesh_forces;
   // The criteria see every load at its peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads) {

@@ -1,6 +1,6 @@
 // End-to-end: obstacles from the scene file — a block dropped on an implicit sphere (a level set)
-// stays within the contact tolerance and reports its contacts; a block pressed onto a plane
-// obstacle carries the load; bad obstacle keys name their path.
+// stays within the contact tolerance and reports its contacts; a block
+// pressed onto a plane obstacle carries the load; bad obstacle keys name their path.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -95,7 +95,7 @@ TEST(CliContact, BadObstaclesNameTheirKey) {
   write_text(folder.path() / "inside.json", scene.dump(2));
   result = run_strata("run inside.json --quiet", folder.path());
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("obstacles.0: vertex"));
+  EXPECT_THAT(result.err, HasSubstr("obstacles.0: contact point"));
   scene = drop_scene();
   scene["hierarchy"] = {{"levels", 1}};
   write_text(folder.path() / "tree.json", scene.dump(2));

@@ -30,7 +30,7 @@ Obstacle sphere_obstacle(const Vector3d& center, double radius, double friction 
 
 TEST(ContactBarrier, DerivativesMatchFiniteDifferences) {
   std::vector<Obstacle> none;
-  const ContactTerm term(none, {}, {0.01, 3.0, 1e-4});
+  const ContactTerm term(none, std::vector<int>{}, {0.01, 3.0, 1e-4});
   EXPECT_EQ(term.barrier(0.01), 0.0);
   EXPECT_EQ(term.barrier_derivative(0.02), 0.0);
   for (double d : {1e-4, 1e-3, 5e-3, 9.9e-3}) {
@@ -221,6 +221,44 @@ TEST(ContactScenes, BlockDroppedOnASphereStaysWithinTheTolerance) {
   EXPECT_GT(*std::max_element(sim.contact_counts().begin(), sim.contact_counts().end()), 0);
 }
 
+TEST(ContactScenes, PointsBoundByWeightsCarryTheBodyWhereItsVerticesDoNotTouch) {
+  // A block 5 cm above a plane; extra contact points extrapolated half a block height below its
+  // bottom vertices (weights 1.5 and −0.5 on a vertical edge, as a bound fine surface outside the
+  // coarse mesh gets) touch the plane: they, not the vertices, hold it up.
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0.05), Vector3d(0.1, 0.1, 0.15), {1, 1, 1});
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+  for (Index bottom = 0; bottom < mesh.vertices.rows(); ++bottom) {
+    if (mesh.vertices(bottom, 2) > 0.05 + 1e-12) continue;
+    for (Index top = 0; top < mesh.vertices.rows(); ++top)
+      if (mesh.vertices(top, 2) > 0.15 - 1e-12 &&
+          (mesh.vertices.row(top).head<2>() - mesh.vertices.row(bottom).head<2>()).norm() < 1e-12)
+        options.contact_points.push_back(
+            {{static_cast<int>(bottom), static_cast<int>(top)}, {1.5, -0.5}});
+  }
+  ASSERT_EQ(options.contact_points.size(), 4u);
+  SolverSettings settings;
+  settings.dt = 2e-3;
+  settings.duration = 0.3;
+  Material material = rubber();
+  material.mass_damping = 20.0;  // settle
+  Simulation sim(mesh, material, {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings,
+                 std::move(options));
+  while (!sim.finished())
+    sim.advance();
+  double lowest = 1.0;
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    lowest = std::min(lowest, sim.positions()[3 * v + 2]);
+  EXPECT_GT(lowest, 0.04);  // the block's own vertices stay well above the plane
+  const VectorXd f = sim.contact_forces();
+  double lift = 0.0;
+  for (Index v = 0; v < f.size() / 3; ++v)
+    lift += f[3 * v + 2];
+  const double weight = sim.vertex_mass().sum() * 9.81;
+  EXPECT_NEAR(lift, weight, 0.02 * weight);  // at rest: the points carry the weight
+  EXPECT_LE(sim.max_penetration(), sim.contact_settings().distance);
+}
+
 TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
   SimulationOptions options;
   options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
@@ -251,7 +289,7 @@ TEST(ContactScenes, StartingInsideAnObstacleIsAnError) {
                    std::move(options));
     FAIL() << "no error";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("obstacles.0: vertex"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("obstacles.0: contact point"), std::string::npos)
         << error.what();
   }
 }

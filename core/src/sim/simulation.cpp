@@ -118,23 +118,34 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   }
   ContactSettings contact;
   if (!options.obstacles.empty()) {
-    if (!m_embedded->is_identity())
-      throw InputError("obstacles: not supported on a mesh with hanging vertices");
     m_obstacles = std::move(options.obstacles);
     for (const Obstacle& obstacle : m_obstacles)
       validate_obstacle(obstacle);
+    // Contact points on the mesh: every boundary vertex, then the extra points; each carried to
+    // the DOFs through the embedding's rows (a hanging vertex by its constraint).
+    std::vector<ContactPoint> mesh_points;
     std::vector<char> on_boundary(num_vertices, 0);
     for (Index f = 0; f < m_boundary.rows(); ++f)
       for (int k = 0; k < 3; ++k)
         on_boundary[m_boundary(f, k)] = 1;
     for (Index v = 0; v < num_vertices; ++v)
-      if (on_boundary[v]) m_contact_vertices.push_back(static_cast<int>(v));
+      if (on_boundary[v]) mesh_points.push_back({{static_cast<int>(v)}, {1.0}});
+    for (const ContactPoint& point : options.contact_points) {
+      if (point.vertices.empty() || point.vertices.size() != point.weights.size())
+        throw InputError("simulation: a contact point needs one weight per vertex");
+      for (int v : point.vertices)
+        if (v < 0 || v >= num_vertices)
+          throw InputError("simulation: contact point vertex " + std::to_string(v) +
+                           " is not a mesh vertex");
+      mesh_points.push_back(point);
+    }
+    m_contact_points = embed_points(mesh_points);
     contact.distance =
         m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * m_diagonal;
     contact.stiffness = m_material.youngs_modulus * m_embedded->mean_edge_length();
     contact.friction_slip =
-        m_settings.friction_slip > 0.0 ? m_settings.friction_slip : 1e-4 * contact.distance;
-    m_contact = std::make_unique<ContactTerm>(m_obstacles, m_contact_vertices, contact);
+        m_settings.friction_slip > 0.0 ? m_settings.friction_slip : 1e-3 * contact.distance;
+    m_contact = std::make_unique<ContactTerm>(m_obstacles, m_contact_points, contact);
   }
   m_x = m_embedded->rest_positions();
   m_v = VectorXd::Zero(m_x.size());
@@ -154,7 +165,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .timed_forces = &m_timed,
                              .springs = m_springs.get(),
                              .obstacles = &m_obstacles,
-                             .contact_vertices = &m_contact_vertices,
+                             .contact_points = &m_contact_points,
                              .contact = contact});
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
   if (is_static()) {
@@ -168,11 +179,11 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     const double t = is_static() ? 0.0 : time();
     m_contact->set_step(m_x, t, t);
     for (const Obstacle& obstacle : m_obstacles)
-      for (int v : m_contact_vertices) {
+      for (Index p = 0; p < m_contact->num_points(); ++p) {
         Vector3d gradient;
-        const double phi = obstacle.distance_at(m_x.segment<3>(3 * v), t, gradient);
+        const double phi = obstacle.distance_at(m_contact->position(m_x, p), t, gradient);
         if (!(phi > -contact.distance))
-          throw InputError(obstacle.name + ": vertex " + std::to_string(v) + " starts " +
+          throw InputError(obstacle.name + ": contact point " + std::to_string(p) + " starts " +
                            format_number(-phi) +
                            " m inside the obstacle (more than the contact "
                            "tolerance " +
@@ -256,6 +267,32 @@ void Simulation::advance() {
   ++m_steps;
   check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
                    m_steps, time(), std::string(m_stepper_traits->name));
+}
+
+std::vector<ContactPoint> Simulation::embed_points(const std::vector<ContactPoint>& points) const {
+  if (m_embedded->is_identity()) return points;
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> C = m_embedded->vertex_embedding();
+  std::vector<ContactPoint> embedded;
+  embedded.reserve(points.size());
+  for (const ContactPoint& point : points) {
+    std::vector<std::pair<int, double>> terms;
+    for (size_t k = 0; k < point.vertices.size(); ++k)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(C, point.vertices[k]); it;
+           ++it)
+        terms.emplace_back(static_cast<int>(it.col()), point.weights[k] * it.value());
+    std::sort(terms.begin(), terms.end());
+    ContactPoint result;
+    for (const auto& [q, w] : terms) {
+      if (!result.vertices.empty() && result.vertices.back() == q) {
+        result.weights.back() += w;
+      } else {
+        result.vertices.push_back(q);
+        result.weights.push_back(w);
+      }
+    }
+    embedded.push_back(std::move(result));
+  }
+  return embedded;
 }
 
 void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {

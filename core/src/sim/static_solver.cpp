@@ -18,7 +18,7 @@ StaticSolver::StaticSolver(const Problem& problem, LinearSolverKind solver, Newt
   m_energy.emplace<ElasticTerm>(problem.model);
   if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(*problem.springs);
   if (problem.has_obstacles())
-    m_contact = &m_energy.emplace<ContactTerm>(*problem.obstacles, *problem.contact_vertices,
+    m_contact = &m_energy.emplace<ContactTerm>(*problem.obstacles, *problem.contact_points,
                                                problem.contact);
   m_external = &m_energy.emplace<ExternalWorkTerm>(problem.external_forces);
   if (problem.ground != nullptr)

@@ -84,7 +84,7 @@ class SceneSimulation {
       if (scene.hierarchy) {
         auto adaptive = std::make_unique<AdaptiveSimulation>(
             mesh, *scene.hierarchy, scene.material, scene.dirichlet_groups(), scene.forces,
-            scene.ground, scene.gravity, scene.solver);
+            scene.ground, scene.gravity, scene.solver, build_obstacles(scene, mesh));
         m_adaptive = adaptive.get();
         m_run = std::move(adaptive);
       } else {

@@ -1,7 +1,9 @@
 #include "strata/core/sim/energy/contact_term.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "strata/core/common/error.hpp"
 
@@ -19,11 +21,53 @@ double f0(double y, double epsilon) {
 
 }  // namespace
 
-ContactTerm::ContactTerm(const std::vector<Obstacle>& obstacles, std::vector<int> vertices,
+namespace {
+
+std::vector<ContactPoint> unit_points(const std::vector<int>& vertices) {
+  std::vector<ContactPoint> points;
+  points.reserve(vertices.size());
+  for (int v : vertices)
+    points.push_back({{v}, {1.0}});
+  return points;
+}
+
+/// Adds `block` to the 3×3 block (a, b) of `hessian`, which must hold it.
+void add_block(SparseMatrixd& hessian, int a, int b, const Matrix3d& block) {
+  for (int c = 0; c < 3; ++c) {
+    const Index column = 3 * b + c;
+    const int* begin = hessian.innerIndexPtr() + hessian.outerIndexPtr()[column];
+    const int* end = hessian.innerIndexPtr() + hessian.outerIndexPtr()[column + 1];
+    const int* row = std::lower_bound(begin, end, 3 * a);
+    if (row == end || *row != 3 * a || row + 2 >= end)
+      throw std::logic_error("ContactTerm: the Hessian pattern lacks a contact block");
+    double* values = hessian.valuePtr() + (row - hessian.innerIndexPtr());
+    for (int r = 0; r < 3; ++r)
+      values[r] += block(r, c);
+  }
+}
+
+}  // namespace
+
+ContactTerm::ContactTerm(const std::vector<Obstacle>& obstacles, const std::vector<int>& vertices,
                          ContactSettings settings)
-    : m_obstacles(obstacles), m_vertices(std::move(vertices)), m_settings(settings) {
+    : ContactTerm(obstacles, unit_points(vertices), settings) {}
+
+ContactTerm::ContactTerm(const std::vector<Obstacle>& obstacles, std::vector<ContactPoint> points,
+                         ContactSettings settings)
+    : m_obstacles(obstacles), m_points(std::move(points)), m_settings(settings) {
   if (!(settings.distance > 0.0) || !(settings.stiffness > 0.0) || !(settings.friction_slip > 0.0))
     throw InputError("contact: distance, stiffness and friction_slip must be positive");
+  for (const ContactPoint& point : m_points)
+    if (point.vertices.empty() || point.vertices.size() != point.weights.size())
+      throw std::invalid_argument("ContactTerm: a point needs one weight per vertex");
+}
+
+Vector3d ContactTerm::position(ConstRef<VectorXd> q, Index p) const {
+  const ContactPoint& point = m_points[p];
+  Vector3d x = Vector3d::Zero();
+  for (size_t k = 0; k < point.vertices.size(); ++k)
+    x += point.weights[k] * q.segment<3>(3 * point.vertices[k]);
+  return x;
 }
 
 double ContactTerm::barrier(double d) const {
@@ -52,16 +96,16 @@ void ContactTerm::set_step(ConstRef<VectorXd> q0, double t0, double t1) {
   for (size_t o = 0; o < m_obstacles.size(); ++o) {
     const Obstacle& obstacle = m_obstacles[o];
     if (obstacle.friction == 0.0) continue;
-    for (int v : m_vertices) {
+    for (Index p = 0; p < num_points(); ++p) {
       Vector3d gradient;
-      const Vector3d x0 = q0.segment<3>(3 * v);
+      const Vector3d x0 = position(q0, p);
       const double d = obstacle.distance_at(x0, t0, gradient) + m_settings.distance;
       if (!(d > 0.0) || d >= m_settings.distance || gradient.norm() == 0.0) continue;
       const Vector3d n = gradient.normalized();
       const Vector3d seed = std::abs(n.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
       const Vector3d t1v = n.cross(seed).normalized();
       FrictionPair pair;
-      pair.vertex = v;
+      pair.point = static_cast<int>(p);
       pair.obstacle = static_cast<int>(o);
       pair.weight = obstacle.friction * -barrier_derivative(d);
       pair.basis.col(0) = t1v;
@@ -75,56 +119,58 @@ void ContactTerm::set_step(ConstRef<VectorXd> q0, double t0, double t1) {
 double ContactTerm::value(ConstRef<VectorXd> q) const {
   double energy = 0.0;
   for (const Obstacle& obstacle : m_obstacles)
-    for (int v : m_vertices) {
+    for (Index p = 0; p < num_points(); ++p) {
       Vector3d gradient;
-      const double d =
-          obstacle.distance_at(q.segment<3>(3 * v), m_time, gradient) + m_settings.distance;
+      const double d = obstacle.distance_at(position(q, p), m_time, gradient) + m_settings.distance;
       if (!(d > 0.0)) return std::numeric_limits<double>::infinity();
       energy += barrier(d);
     }
   const double epsilon = m_settings.friction_slip;
   for (const FrictionPair& pair : m_friction) {
-    const Eigen::Vector2d u =
-        pair.basis.transpose() * (q.segment<3>(3 * pair.vertex) - pair.reference);
+    const Eigen::Vector2d u = pair.basis.transpose() * (position(q, pair.point) - pair.reference);
     energy += pair.weight * f0(u.norm(), epsilon);
   }
   return energy;
 }
 
 void ContactTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
+  const auto scatter = [&](Index p, const Vector3d& force) {
+    const ContactPoint& point = m_points[p];
+    for (size_t k = 0; k < point.vertices.size(); ++k)
+      gradient.segment<3>(3 * point.vertices[k]) += point.weights[k] * force;
+  };
   for (const Obstacle& obstacle : m_obstacles)
-    for (int v : m_vertices) {
+    for (Index p = 0; p < num_points(); ++p) {
       Vector3d n;
-      const double d = obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      const double d = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
       if (!(d > 0.0) || d >= m_settings.distance) continue;
-      gradient.segment<3>(3 * v) += barrier_derivative(d) * n;
+      scatter(p, barrier_derivative(d) * n);
     }
   const double epsilon = m_settings.friction_slip;
   for (const FrictionPair& pair : m_friction) {
-    const Eigen::Vector2d u =
-        pair.basis.transpose() * (q.segment<3>(3 * pair.vertex) - pair.reference);
-    gradient.segment<3>(3 * pair.vertex) +=
-        pair.weight * f1_over_y(u.norm(), epsilon) * (pair.basis * u);
+    const Eigen::Vector2d u = pair.basis.transpose() * (position(q, pair.point) - pair.reference);
+    scatter(pair.point, pair.weight * f1_over_y(u.norm(), epsilon) * (pair.basis * u));
   }
 }
 
 void ContactTerm::add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool) const {
-  const auto add_block = [&](int v, const Matrix3d& block) {
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r)
-        hessian.coeffRef(3 * v + r, 3 * v + c) += block(r, c);
+  const auto scatter = [&](Index p, const Matrix3d& block) {
+    const ContactPoint& point = m_points[p];
+    for (size_t a = 0; a < point.vertices.size(); ++a)
+      for (size_t b = 0; b < point.vertices.size(); ++b)
+        add_block(hessian, point.vertices[a], point.vertices[b],
+                  point.weights[a] * point.weights[b] * block);
   };
   for (const Obstacle& obstacle : m_obstacles)
-    for (int v : m_vertices) {
+    for (Index p = 0; p < num_points(); ++p) {
       Vector3d n;
-      const double d = obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      const double d = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
       if (!(d > 0.0) || d >= m_settings.distance) continue;
-      add_block(v, barrier_second_derivative(d) * n * n.transpose());
+      scatter(p, barrier_second_derivative(d) * n * n.transpose());
     }
   const double epsilon = m_settings.friction_slip;
   for (const FrictionPair& pair : m_friction) {
-    const Eigen::Vector2d u =
-        pair.basis.transpose() * (q.segment<3>(3 * pair.vertex) - pair.reference);
+    const Eigen::Vector2d u = pair.basis.transpose() * (position(q, pair.point) - pair.reference);
     const double y = u.norm();
     Eigen::Matrix2d M;
     if (y >= epsilon) {
@@ -133,19 +179,18 @@ void ContactTerm::add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool
       M = f1_over_y(y, epsilon) * Eigen::Matrix2d::Identity();
       if (y > 0.0) M -= u * u.transpose() / (epsilon * epsilon * y);
     }
-    add_block(pair.vertex, pair.weight * pair.basis * M * pair.basis.transpose());
+    scatter(pair.point, pair.weight * pair.basis * M * pair.basis.transpose());
   }
 }
 
 double ContactTerm::max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const {
   double alpha = 1.0;
   for (const Obstacle& obstacle : m_obstacles)
-    for (int v : m_vertices) {
-      const double move = step.segment<3>(3 * v).norm();
+    for (Index p = 0; p < num_points(); ++p) {
+      const double move = position(step, p).norm();
       if (move == 0.0) continue;
       Vector3d n;
-      const double room =
-          obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      const double room = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
       if (room > 0.0) alpha = std::min(alpha, 0.9 * room / move);
     }
   return alpha;
@@ -154,11 +199,13 @@ double ContactTerm::max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) cons
 Index ContactTerm::add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const {
   Index active = 0;
   for (const Obstacle& obstacle : m_obstacles)
-    for (int v : m_vertices) {
+    for (Index p = 0; p < num_points(); ++p) {
       Vector3d n;
-      const double d = obstacle.distance_at(q.segment<3>(3 * v), m_time, n) + m_settings.distance;
+      const double d = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
       if (!(d > 0.0) || d >= m_settings.distance) continue;
-      f.segment<3>(3 * v) -= barrier_derivative(d) * n;
+      const ContactPoint& point = m_points[p];
+      for (size_t k = 0; k < point.vertices.size(); ++k)
+        f.segment<3>(3 * point.vertices[k]) -= point.weights[k] * barrier_derivative(d) * n;
       ++active;
     }
   return active;
@@ -167,9 +214,9 @@ Index ContactTerm::add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const {
 double ContactTerm::min_distance(ConstRef<VectorXd> q) const {
   double smallest = std::numeric_limits<double>::infinity();
   for (const Obstacle& obstacle : m_obstacles)
-    for (int v : m_vertices) {
+    for (Index p = 0; p < num_points(); ++p) {
       Vector3d n;
-      smallest = std::min(smallest, obstacle.distance_at(q.segment<3>(3 * v), m_time, n));
+      smallest = std::min(smallest, obstacle.distance_at(position(q, p), m_time, n));
     }
   return smallest;
 }

@@ -142,11 +142,15 @@ class AdaptiveSimulation final : public SimulationRun {
  public:
   /// `coarse`: the roots (validated and oriented by the caller, as for Simulation). The region
   /// loads are applied on the finest level; gravity, Dirichlet groups, ground and solver settings
-  /// as in Simulation. Throws InputError for invalid settings or scene data.
+  /// as in Simulation; `obstacles` (SimulationOptions::obstacles) are contacted by every active
+  /// cut's boundary vertices, hanging ones included (cut changes near a curved obstacle can stall
+  /// Newton: the CLI does not offer obstacles with a hierarchy yet). Throws InputError for
+  /// invalid settings or scene data.
   AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
                      const Material& material, std::vector<DirichletSpec> dirichlet,
                      const std::vector<RegionLoad>& loads, std::optional<GroundPlane> ground,
-                     const Vector3d& gravity, const SolverSettings& settings);
+                     const Vector3d& gravity, const SolverSettings& settings,
+                     std::vector<Obstacle> obstacles = {});
   ~AdaptiveSimulation() override;
   AdaptiveSimulation(const AdaptiveSimulation&) = delete;
   AdaptiveSimulation& operator=(const AdaptiveSimulation&) = delete;
@@ -226,6 +230,7 @@ class AdaptiveSimulation final : public SimulationRun {
   std::unique_ptr<ActiveCut> m_cut;
   std::unique_ptr<TreePointLocator> m_locator;
   std::unique_ptr<RefinementController> m_controller;
+  std::vector<Obstacle> m_obstacles;
   std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
   /// Loads with an amplitude, each on the finest level.
   std::vector<std::pair<Amplitude, std::vector<PointLoad>>> m_timed_point_loads;

@@ -51,10 +51,10 @@ struct Problem {
   const std::vector<TimedForces>* timed_forces = nullptr;
   /// Surface springs on the DOF vertices (meshes without an embedding); null: none.
   const SurfaceSprings* springs = nullptr;
-  /// Rigid obstacles (energy/contact_term.hpp), the DOF vertices tested against them and the
+  /// Rigid obstacles (energy/contact_term.hpp), the points tested against them and the
   /// contact settings; null or empty: none.
   const std::vector<Obstacle>* obstacles = nullptr;
-  const std::vector<int>* contact_vertices = nullptr;
+  const std::vector<ContactPoint>* contact_points = nullptr;
   ContactSettings contact{};
 
   /// s(t) = min(t / T_r, 1).

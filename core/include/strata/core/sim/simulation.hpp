@@ -83,8 +83,13 @@ struct SimulationOptions {
   /// edges; meshes without an embedding only.
   std::optional<SurfaceSpringSettings> surface_springs;
   /// Rigid obstacles (obstacle.hpp) the boundary vertices contact through a barrier (implicit
-  /// and static steps) or a projection (explicit steps); meshes without an embedding only.
+  /// and static steps) or a projection (explicit steps, DOF vertices only). With an embedding a
+  /// hanging boundary vertex is tested where its constraint puts it.
   std::vector<Obstacle> obstacles;
+  /// Further contact points as weighted mesh vertices (e.g. the vertices of a bound fine surface,
+  /// through their barycentric weights): the barrier and friction act on them too and their
+  /// forces reach the DOFs through the weights.
+  std::vector<ContactPoint> contact_points;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
@@ -261,7 +266,9 @@ class Simulation final : public SimulationRun {
   PlasticState m_plastic;
   std::unique_ptr<SurfaceSprings> m_springs;
   std::vector<Obstacle> m_obstacles;
-  std::vector<int> m_contact_vertices;
+  std::vector<ContactPoint> m_contact_points;  ///< on the DOFs
+  /// Mesh-vertex contact points carried to the DOFs through the embedding's rows.
+  std::vector<ContactPoint> embed_points(const std::vector<ContactPoint>& points) const;
   std::unique_ptr<ContactTerm> m_contact;  ///< mirrors the stepper's, lagged at the last step
   double m_max_penetration = 0.0;
   std::vector<Index> m_contact_counts;

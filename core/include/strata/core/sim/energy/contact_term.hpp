@@ -25,6 +25,14 @@
 
 namespace strata {
 
+/// A point tested for contact: a fixed linear combination Σ w_k q_{v_k} of DOF vertices (a DOF
+/// vertex itself, a hanging vertex through its constraint row, or a fine-surface vertex through
+/// its binding weights). Its forces reach the DOFs through the same weights.
+struct ContactPoint {
+  std::vector<int> vertices;  ///< DOF vertices
+  std::vector<double> weights;
+};
+
 struct ContactSettings {
   double distance = 0.0;       ///< d̂ > 0 [m]: the tolerance, the largest possible depth
   double stiffness = 0.0;      ///< κ > 0 [N/m]
@@ -35,7 +43,12 @@ class ContactTerm final : public EnergyTerm {
  public:
   /// `vertices`: the DOF vertices tested against every obstacle. `obstacles` must outlive the
   /// term.
-  ContactTerm(const std::vector<Obstacle>& obstacles, std::vector<int> vertices,
+  ContactTerm(const std::vector<Obstacle>& obstacles, const std::vector<int>& vertices,
+              ContactSettings settings);
+  /// `points`: weighted combinations of DOF vertices tested against every obstacle; the Hessian
+  /// couples the vertices of a point, which must share a block of the pattern (vertices of one
+  /// element, through the embedding).
+  ContactTerm(const std::vector<Obstacle>& obstacles, std::vector<ContactPoint> points,
               ContactSettings settings);
   std::string_view name() const override { return "contact"; }
 
@@ -55,6 +68,9 @@ class ContactTerm final : public EnergyTerm {
   /// Adds the barrier's (normal) contact forces −∂b/∂q at the end-of-step placement into `f`;
   /// returns the vertex–obstacle pairs in contact (φ < 0).
   Index add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const;
+  Index num_points() const { return static_cast<Index>(m_points.size()); }
+  /// Position of point p at DOF state q.
+  Vector3d position(ConstRef<VectorXd> q, Index p) const;
   /// Smallest φ over the tested vertices and the obstacles at the end-of-step placement (+∞
   /// without obstacles).
   double min_distance(ConstRef<VectorXd> q) const;
@@ -67,14 +83,14 @@ class ContactTerm final : public EnergyTerm {
 
  private:
   struct FrictionPair {
-    int vertex;
+    int point;
     int obstacle;
     double weight;  ///< μ λ [N]
     Eigen::Matrix<double, 3, 2> basis;
     Vector3d reference;  ///< x₀ + v_o Δt
   };
   const std::vector<Obstacle>& m_obstacles;
-  std::vector<int> m_vertices;
+  std::vector<ContactPoint> m_points;
   ContactSettings m_settings;
   double m_time = 0.0;
   std::vector<FrictionPair> m_friction;
