@@ -139,6 +139,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                            " is not a mesh vertex");
       mesh_points.push_back(point);
     }
+    m_extra_contact_points = static_cast<Index>(options.contact_points.size());
     m_contact_points = embed_points(mesh_points);
     contact.distance =
         m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * m_diagonal;

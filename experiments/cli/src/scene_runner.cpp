@@ -22,6 +22,7 @@
 #include "strata/hierarchy/adaptive_simulation.hpp"
 #include "strata/meshing/implicit_shape.hpp"
 #include "strata/meshing/level_set_obstacle.hpp"
+#include "strata/meshing/surface_binding.hpp"
 #include "strata/meshing/surface_io.hpp"
 
 namespace strata::app {
@@ -91,6 +92,17 @@ class SceneSimulation {
         SimulationOptions options;
         options.surface_springs = scene.surface_springs;
         options.obstacles = build_obstacles(scene, mesh);
+        if (!options.obstacles.empty() && scene.mesh.surface) {
+          // The fine surface collides too: its vertices are contact points through their binding.
+          const SurfaceMesh surface = read_surface(*scene.mesh.surface);
+          const SurfaceBinding binding = bind_surface(mesh, surface.vertices);
+          for (Index i = 0; i < binding.corners.rows(); ++i)
+            options.contact_points.push_back(
+                {{binding.corners(i, 0), binding.corners(i, 1), binding.corners(i, 2),
+                  binding.corners(i, 3)},
+                 {binding.barycentric(i, 0), binding.barycentric(i, 1), binding.barycentric(i, 2),
+                  binding.barycentric(i, 3)}});
+        }
         m_run = std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
                                              scene.forces, scene.ground, scene.gravity,
                                              scene.solver, std::move(options));
@@ -249,6 +261,8 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                         {"tolerance", contact.distance},
                         {"barrier_stiffness", contact.stiffness},
                         {"friction_slip", contact.friction_slip},
+                        {"points", simulation.contact_points()},
+                        {"surface_points", simulation.extra_contact_points()},
                         {"active_contacts", simulation.contact_counts()}};
   }
   if (scene.material.plasticity) {

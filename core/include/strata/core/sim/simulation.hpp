@@ -214,6 +214,10 @@ class Simulation final : public SimulationRun {
   bool has_obstacles() const { return !m_obstacles.empty(); }
   const ContactSettings& contact_settings() const;
   double max_penetration() const { return m_max_penetration; }
+  /// Points tested for contact (boundary vertices, then SimulationOptions::contact_points).
+  Index contact_points() const { return static_cast<Index>(m_contact_points.size()); }
+  /// Of those, the SimulationOptions::contact_points.
+  Index extra_contact_points() const { return m_extra_contact_points; }
   const std::vector<Index>& contact_counts() const { return m_contact_counts; }
   VectorXd contact_forces() const;
   /// Whether the material is plastic.
@@ -267,6 +271,7 @@ class Simulation final : public SimulationRun {
   std::unique_ptr<SurfaceSprings> m_springs;
   std::vector<Obstacle> m_obstacles;
   std::vector<ContactPoint> m_contact_points;  ///< on the DOFs
+  Index m_extra_contact_points = 0;
   /// Mesh-vertex contact points carried to the DOFs through the embedding's rows.
   std::vector<ContactPoint> embed_points(const std::vector<ContactPoint>& points) const;
   std::unique_ptr<ContactTerm> m_contact;  ///< mirrors the stepper's, lagged at the last step
