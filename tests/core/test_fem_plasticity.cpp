@@ -114,6 +114,16 @@ struct UniaxialBar {
     }
     return groups;
   }
+  /// The end face x = L pulled to `strains` yield strains along x (x only).
+  DirichletSpec pull(double strains) const {
+    DirichletSpec spec;
+    spec.name = "prescribed[0]";
+    spec.region = PlaneRegion{Vector3d(kLength, 0, 0), Vector3d::UnitX(), 0.0};
+    spec.kind = DirichletKind::displacement;
+    spec.displacement = Vector3d(strains * kYield / kE * kLength, 0, 0);
+    spec.components = {true, false, false};
+    return spec;
+  }
   /// Mean x displacement of the end face x = L.
   double end_displacement(const Simulation& sim) const {
     double sum = 0.0;
@@ -143,13 +153,7 @@ class UniaxialPlateau : public ::testing::TestWithParam<MaterialModel> {};
 TEST_P(UniaxialPlateau, PerfectPlasticityHoldsTheYieldStress) {
   const UniaxialBar bar;
   std::vector<DirichletSpec> groups = bar.symmetry();
-  DirichletSpec pull;
-  pull.name = "prescribed[0]";
-  pull.region = PlaneRegion{Vector3d(kLength, 0, 0), Vector3d::UnitX(), 0.0};
-  pull.kind = DirichletKind::displacement;
-  pull.displacement = Vector3d(5 * kYield / kE * kLength, 0, 0);  // 5 × the yield strain
-  pull.components = {true, false, false};
-  groups.push_back(pull);
+  groups.push_back(bar.pull(5.0));
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 10;
@@ -246,13 +250,7 @@ TEST(UniaxialDynamic, ImplicitStepsHoldThePlateau) {
   // Backward Euler, a slow pull with heavy mass damping: quasi-static, so the stress plateaus.
   const UniaxialBar bar;
   std::vector<DirichletSpec> groups = bar.symmetry();
-  DirichletSpec pull;
-  pull.name = "prescribed[0]";
-  pull.region = PlaneRegion{Vector3d(kLength, 0, 0), Vector3d::UnitX(), 0.0};
-  pull.kind = DirichletKind::displacement;
-  pull.displacement = Vector3d(3 * kYield / kE * kLength, 0, 0);
-  pull.components = {true, false, false};
-  groups.push_back(pull);
+  groups.push_back(bar.pull(3.0));
   Material material = plastic_material(MaterialModel::neohookean, 0.0);
   material.density = 10.0;
   material.mass_damping = 50.0;

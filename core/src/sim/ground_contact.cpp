@@ -24,16 +24,20 @@ Index project_ground_contact(const GroundPlane& ground, VectorXd& x, VectorXd& v
     if (depth >= 0.0) continue;
     ++contacts;
     x.segment<3>(3 * i) -= depth * n;
-    const Vector3d vel = v.segment<3>(3 * i);
-    const double v_n = n.dot(vel);
-    const double dv_n = std::max(0.0, -v_n);
-    const Vector3d v_t = vel - v_n * n;
-    const double speed_t = v_t.norm();
-    const double reduced = std::max(0.0, speed_t - ground.friction * dv_n);
-    const Vector3d new_t = speed_t > 0.0 ? Vector3d(v_t * (reduced / speed_t)) : Vector3d::Zero();
-    v.segment<3>(3 * i) = new_t + std::max(v_n, 0.0) * n;
+    v.segment<3>(3 * i) = contact_velocity_update(v.segment<3>(3 * i), n, ground.friction);
   }
   return contacts;
+}
+
+Vector3d contact_velocity_update(const Vector3d& relative_velocity, const Vector3d& n,
+                                 double friction) {
+  const double v_n = n.dot(relative_velocity);
+  const double dv_n = std::max(0.0, -v_n);
+  const Vector3d v_t = relative_velocity - v_n * n;
+  const double speed_t = v_t.norm();
+  const double reduced = std::max(0.0, speed_t - friction * dv_n);
+  const Vector3d new_t = speed_t > 0.0 ? Vector3d(v_t * (reduced / speed_t)) : Vector3d::Zero();
+  return new_t + std::max(v_n, 0.0) * n;
 }
 
 double ground_penalty_stiffness(double youngs_modulus, double mean_edge_length, double factor) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/sim/ground_contact.hpp"
 
 namespace strata {
 
@@ -40,14 +41,9 @@ Index project_obstacle_contact(const std::vector<Obstacle>& obstacles, double t,
       ++contacts;
       const Vector3d n = gradient.normalized();
       x.segment<3>(3 * i) -= phi * n;
-      const Vector3d relative = v.segment<3>(3 * i) - obstacle.velocity;
-      const double v_n = n.dot(relative);
-      const double dv_n = std::max(0.0, -v_n);
-      const Vector3d v_t = relative - v_n * n;
-      const double speed_t = v_t.norm();
-      const double reduced = std::max(0.0, speed_t - obstacle.friction * dv_n);
-      const Vector3d new_t = speed_t > 0.0 ? Vector3d(v_t * (reduced / speed_t)) : Vector3d::Zero();
-      v.segment<3>(3 * i) = obstacle.velocity + new_t + std::max(v_n, 0.0) * n;
+      v.segment<3>(3 * i) =
+          obstacle.velocity +
+          contact_velocity_update(v.segment<3>(3 * i) - obstacle.velocity, n, obstacle.friction);
     }
   }
   return contacts;

@@ -58,6 +58,11 @@ LinearSolverKind linear_solver_from_string(const std::string& name) {
   throw InputError("unknown linear solver '" + name + "' (valid: cholmod, cg, multigrid, auto)");
 }
 
+int newton_iteration_limit(const SolverSettings& settings, bool contact) {
+  if (settings.max_newton_iterations > 0) return settings.max_newton_iterations;
+  return contact ? 200 : 50;
+}
+
 void validate_solver_settings(const SolverSettings& s, const std::string& where) {
   auto positive = [&](double value, const char* key) {
     if (!std::isfinite(value) || value <= 0.0)
@@ -75,7 +80,8 @@ void validate_solver_settings(const SolverSettings& s, const std::string& where)
   if (!std::isfinite(s.ramp_time) || s.ramp_time < 0.0)
     throw InputError(where + ".ramp_time: must be a finite number >= 0");
   if (s.load_steps < 1) throw InputError(where + ".load_steps: must be >= 1");
-  if (s.max_newton_iterations < 1) throw InputError(where + ".max_newton_iterations: must be >= 1");
+  if (s.max_newton_iterations < 0)
+    throw InputError(where + ".max_newton_iterations: must be >= 0 (0: automatic)");
   if (s.max_plastic_passes < 1) throw InputError(where + ".max_plastic_passes: must be >= 1");
 }
 

@@ -53,13 +53,13 @@ double SurfaceSprings::energy(ConstRef<VectorXd> x) const {
   return energy;
 }
 
-void SurfaceSprings::add_forces(ConstRef<VectorXd> x, VectorXd& f) const {
+void SurfaceSprings::add_forces(ConstRef<VectorXd> x, VectorXd& f, double scale) const {
   for (Index s = 0; s < size(); ++s) {
     const auto [a, b] = m_edges[s];
     const Vector3d d = x.segment<3>(3 * b) - x.segment<3>(3 * a);
     const double length = d.norm();
     if (length == 0.0) continue;
-    const Vector3d force = m_stiffness[s] * (length - m_rest[s]) / length * d;  // pulls b to a
+    const Vector3d force = scale * m_stiffness[s] * (length - m_rest[s]) / length * d;
     f.segment<3>(3 * a) += force;
     f.segment<3>(3 * b) -= force;
   }

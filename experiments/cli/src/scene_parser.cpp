@@ -399,10 +399,6 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     }
   }
   scene.solver = parse_solver(top.at("solver"));
-  // Contact solves approach the barrier in steps cut by its filter: more iterations by default.
-  if (!scene.obstacles.empty() && !top.at("solver").has("max_newton_iterations")) {
-    scene.solver.max_newton_iterations = 200;
-  }
   if (top.has("output")) scene.output = parse_output(top.at("output"));
   if (top.has("hierarchy")) scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"));
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&

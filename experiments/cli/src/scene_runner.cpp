@@ -19,6 +19,7 @@
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
 #include "strata/meshing/implicit_shape.hpp"
 #include "strata/meshing/level_set_obstacle.hpp"
@@ -45,10 +46,7 @@ long planned_steps(const SolverSettings& settings) {
 /// surfaces voxelised at `voxel_size`, default half the mesh's mean edge length).
 std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
   std::vector<Obstacle> obstacles;
-  double mean_edge = 0.0;
-  for (Index t = 0; t < mesh.tets.rows(); ++t)
-    mean_edge += (mesh.vertices.row(mesh.tets(t, 1)) - mesh.vertices.row(mesh.tets(t, 0))).norm();
-  mean_edge /= std::max<Index>(1, mesh.tets.rows());
+  const double mean_edge = mean_edge_length(mesh.vertices, mesh.tets);
   for (const ObstacleSpec& spec : scene.obstacles) {
     Obstacle obstacle;
     LevelSetOptions options;
@@ -80,7 +78,8 @@ std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
 class SceneSimulation {
  public:
   /// Core InputErrors get the scene file as prefix.
-  SceneSimulation(const Scene& scene, const TetMesh& mesh) {
+  /// `binding`: the fine surface bound to `mesh` (it collides with the obstacles); may be null.
+  SceneSimulation(const Scene& scene, const TetMesh& mesh, const SurfaceBinding* binding) {
     try {
       if (scene.hierarchy) {
         auto adaptive = std::make_unique<AdaptiveSimulation>(
@@ -92,16 +91,14 @@ class SceneSimulation {
         SimulationOptions options;
         options.surface_springs = scene.surface_springs;
         options.obstacles = build_obstacles(scene, mesh);
-        if (!options.obstacles.empty() && scene.mesh.surface) {
+        if (!options.obstacles.empty() && binding != nullptr) {
           // The fine surface collides too: its vertices are contact points through their binding.
-          const SurfaceMesh surface = read_surface(*scene.mesh.surface);
-          const SurfaceBinding binding = bind_surface(mesh, surface.vertices);
-          for (Index i = 0; i < binding.corners.rows(); ++i)
+          for (Index i = 0; i < binding->corners.rows(); ++i)
             options.contact_points.push_back(
-                {{binding.corners(i, 0), binding.corners(i, 1), binding.corners(i, 2),
-                  binding.corners(i, 3)},
-                 {binding.barycentric(i, 0), binding.barycentric(i, 1), binding.barycentric(i, 2),
-                  binding.barycentric(i, 3)}});
+                {{binding->corners(i, 0), binding->corners(i, 1), binding->corners(i, 2),
+                  binding->corners(i, 3)},
+                 {binding->barycentric(i, 0), binding->barycentric(i, 1),
+                  binding->barycentric(i, 2), binding->barycentric(i, 3)}});
         }
         m_run = std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
                                              scene.forces, scene.ground, scene.gravity,
@@ -339,7 +336,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   } catch (const InputError& error) {
     throw InputError(scene.file.string() + ": " + error.what());
   }
-  SceneSimulation scene_simulation(scene, prepared.mesh);
+  // The fine surface, bound once to the simulation mesh: rendered with the frames and, with
+  // obstacles, tested for contact.
+  std::optional<FineSurface> surface;
+  if (scene.mesh.surface && (scene.output.vtk || !scene.obstacles.empty()))
+    surface.emplace(read_surface(*scene.mesh.surface), prepared.mesh);
+  SceneSimulation scene_simulation(scene, prepared.mesh, surface ? &surface->binding() : nullptr);
   const Simulation* simulation = &scene_simulation.current();
   summary.stable_dt_estimate = simulation->stable_dt_estimate();
   std::vector<RootPoint> probe_roots;
@@ -390,9 +392,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");
   std::optional<VtkSeries> vtk;
   if (scene.output.vtk) vtk.emplace(summary.output_dir, scene.name);
-  std::optional<FineSurface> surface;  // the render surface, bound to the simulation mesh
-  if (vtk && scene.mesh.surface) {
-    surface.emplace(read_surface(*scene.mesh.surface), prepared.mesh);
+  if (surface) {
     if (!options.quiet) {
       log << "strata: surface " << scene.mesh.surface->string() << ": "
           << surface->rest().vertices.rows() << " vertices bound in "

@@ -3,9 +3,7 @@
 namespace strata {
 
 void SpringTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
-  VectorXd forces = VectorXd::Zero(gradient.size());
-  m_springs.add_forces(q, forces);
-  gradient -= forces;
+  m_springs.add_forces(q, gradient, -1.0);
 }
 
 }  // namespace strata

@@ -6,9 +6,9 @@ namespace strata {
 
 StaticLoadStepper::StaticLoadStepper(const Problem& problem, const SolverSettings& settings)
     : m_problem(problem),
-      m_solver(
-          problem, settings.linear_solver,
-          {settings.max_newton_iterations, settings.newton_tolerance, settings.exact_hessian}) {}
+      m_solver(problem, settings.linear_solver,
+               {newton_iteration_limit(settings, problem.has_obstacles()),
+                settings.newton_tolerance, settings.exact_hessian}) {}
 
 NewtonResult StaticLoadStepper::step(double, double t1, double, VectorXd& q, VectorXd& v) {
   VectorXd guess = q;

@@ -33,6 +33,12 @@ void validate_ground(const GroundPlane& ground, const std::string& where);
 Index project_ground_contact(const GroundPlane& ground, VectorXd& x, VectorXd& v,
                              const std::vector<char>& skip);
 
+/// The inelastic, frictional velocity update of a contact with unit normal n̂ on the velocity
+/// relative to the obstacle: the inward normal part is removed (Δv_n = −min(v_n, 0)) and the
+/// tangential speed reduced by μ |Δv_n|, clamped at zero.
+Vector3d contact_velocity_update(const Vector3d& relative_velocity, const Vector3d& normal,
+                                 double friction);
+
 /// Penalty stiffness k [N/m] = factor · E · h, with E Young's modulus [Pa] and h the mean edge
 /// length of the rest mesh [m] (a vertex pushed into the ground feels a stiffness comparable to
 /// `factor` times that of an element around it).

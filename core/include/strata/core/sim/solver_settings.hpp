@@ -23,7 +23,9 @@ struct SolverSettings {
   double ramp_time = 0.0;
   int load_steps = 10;  ///< N: load factor k/N at step k (static)
   LinearSolverKind linear_solver = LinearSolverKind::automatic;
-  int max_newton_iterations = 50;
+  /// Per time or load step; 0: 50, or 200 when there are obstacles (contact solves approach the
+  /// barrier in steps cut by its filter).
+  int max_newton_iterations = 0;
   /// Newton stops when ‖∇E‖ over the free DOFs ≤ tolerance × force scale (static: the applied
   /// external load, or the internal forces of the first guess when there is no load).
   double newton_tolerance = 1e-10;
@@ -52,8 +54,12 @@ SimulationMode simulation_mode_from_string(const std::string& name);
 Integrator integrator_from_string(const std::string& name);
 LinearSolverKind linear_solver_from_string(const std::string& name);
 
+/// Newton's iteration limit per step: `max_newton_iterations`, or when it is 0, 50 (200 with
+/// contact).
+int newton_iteration_limit(const SolverSettings& settings, bool contact);
+
 /// Throws InputError naming `where` (e.g. "solver") unless dt > 0, duration > 0, ramp_time ≥ 0,
-/// load_steps ≥ 1, max_newton_iterations ≥ 1, newton_tolerance > 0, contact factor > 0,
+/// load_steps ≥ 1, max_newton_iterations ≥ 0, newton_tolerance > 0, contact factor > 0,
 /// max_plastic_passes ≥ 1, plastic_tolerance > 0 (all finite).
 void validate_solver_settings(const SolverSettings& settings, const std::string& where);
 

@@ -48,8 +48,8 @@ class SurfaceSprings {
 
   /// Σ ½ k (L − L₀)² at positions x (3·#V) [J].
   double energy(ConstRef<VectorXd> x) const;
-  /// f += −∂E/∂x.
-  void add_forces(ConstRef<VectorXd> x, VectorXd& f) const;
+  /// f += scale · (−∂E/∂x) (scale −1 adds the gradient).
+  void add_forces(ConstRef<VectorXd> x, VectorXd& f, double scale = 1.0) const;
   /// H += ∂²E/∂x² (k [n nᵀ + (1 − L₀/L)(I − n nᵀ)] per spring; with `project_psd` the second
   /// factor is clamped at 0). H must hold every spring's vertex blocks.
   void add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian, bool project_psd) const;
