@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "strata/app/mesh_command.hpp"
+#include "strata/app/precompute_command.hpp"
 #include "strata/app/progress_bar.hpp"
 #include "strata/app/scene_parser.hpp"
 #include "strata/app/scene_runner.hpp"
@@ -135,6 +136,33 @@ int main(int argc, char** argv) {
   convert->add_option("output", convert_out, "Output mesh file (format from the extension)")
       ->required();
 
+  strata::app::PrecomputeCommand precompute_command;
+  CLI::App* precompute = app.add_subcommand(
+      "precompute",
+      "Run scenes adaptively and write the cut they needed, for hierarchy mode \"precomputed\"");
+  precompute->add_option("scenes", precompute_command.scenes, "Scene files (same mesh and levels)")
+      ->required();
+  precompute->add_option("--out", precompute_command.output, "Cut file to write (.json)")
+      ->required();
+  precompute->add_option("--mesh", precompute_command.mesh,
+                         "Also write the cut as a conforming tet mesh (.vtu, .mesh, .msh, .node)");
+  precompute
+      ->add_option("--tolerance", precompute_command.tolerance,
+                   "hierarchy.tolerance of the recorded runs (default: half of each scene's)")
+      ->check(CLI::Range(0.0, 1.0));
+  precompute
+      ->add_option("--windows", precompute_command.windows,
+                   "Cuts in the schedule: equal windows of the run's time (default 1: one cut)")
+      ->check(CLI::PositiveNumber);
+  precompute
+      ->add_option("--set", precompute_command.overrides,
+                   "Override a key of every scene: key.path=value (as for run)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  precompute->add_flag("-q,--quiet", precompute_command.quiet, "No info lines");
+  precompute->add_option("--threads", threads, "Threads of strata's parallel loops (as for run)")
+      ->check(CLI::NonNegativeNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& error) {
@@ -156,6 +184,9 @@ int main(int argc, char** argv) {
       options.quiet = quiet;
       options.progress = !quiet && strata::app::stderr_is_terminal();
       strata::app::run_scene(scene, options);
+    } else if (*precompute) {
+      precompute_command.progress = !precompute_command.quiet && strata::app::stderr_is_terminal();
+      strata::app::run_precompute_command(precompute_command, std::cout);
     } else if (*info) {
       return run_info(info_file, info_grid);
     } else if (*mesh) {

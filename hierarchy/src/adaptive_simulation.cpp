@@ -93,6 +93,8 @@ std::string to_string(HierarchyMode mode) {
       return "uniform";
     case HierarchyMode::adaptive:
       return "adaptive";
+    case HierarchyMode::precomputed:
+      return "precomputed";
   }
   return "?";
 }
@@ -113,6 +115,8 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
   if (!(settings.tolerance > 0.0 && settings.tolerance < 1.0))
     throw InputError(where + ".tolerance: must be in (0, 1)");
   validate_refinement_settings(settings.criteria, where);
+  if (settings.mode == HierarchyMode::precomputed && !settings.precomputed)
+    throw InputError(where + ".cut: mode \"precomputed\" needs a precomputed cut");
 }
 
 AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
@@ -140,7 +144,12 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   m_tolerance = region_tolerance(coarse.vertices);
   const int start_level =
       m_settings.mode == HierarchyMode::full ? m_settings.levels : m_settings.level;
-  m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, start_level));
+  if (m_settings.mode == HierarchyMode::precomputed) {
+    validate_precomputed_cut(*m_settings.precomputed, coarse, m_settings.levels, "hierarchy.cut");
+    m_cut = std::make_unique<ActiveCut>(*m_tree);
+  } else {
+    m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, start_level));
+  }
   m_locator = std::make_unique<TreePointLocator>(*m_tree);
   if (m_settings.indicator == "recovery" && !m_settings.refine_threshold_set)
     m_settings.criteria.refine_threshold = 1.0;  // a tet's equidistributed share of the tolerance
@@ -170,6 +179,10 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
                                      finest_level_loads(*m_tree, {load}, m_tolerance));
   }
   m_point_loads = finest_level_loads(*m_tree, constant_loads, m_tolerance);
+  if (m_settings.mode == HierarchyMode::precomputed) {
+    m_window = m_settings.precomputed->window_at(0.0);
+    move_to_window(m_window, true);
+  }
   make_dirichlet_exact();
   rebuild(0);
   m_bookkeeping_seconds += seconds_since(start);
@@ -230,6 +243,43 @@ void AdaptiveSimulation::initial_adaptation() {
 }
 
 AdaptiveSimulation::~AdaptiveSimulation() = default;
+
+void AdaptiveSimulation::move_to_window(std::size_t w, bool initial) {
+  // One level per pass: refine the active nodes the window refines, merge the parents it does
+  // not (unless a Dirichlet group would become inexact), until the cut is the window's.
+  const RefinedSet refined(m_settings.precomputed->windows[w].refined);
+  const int max_level = max_refine_level();
+  for (int pass = 0; pass <= 2 * m_tree->max_level() + 1; ++pass) {
+    CutChanges changes;
+    std::vector<NodeId> parents;
+    for (NodeId n : m_cut->nodes()) {
+      if (m_tree->level(n) < max_level && refined.contains(*m_tree, n)) {
+        if (is_explicit(m_solver) && !children_stable(n)) {
+          ++m_report.refused_refinements;
+        } else {
+          changes.refine.push_back(n);
+        }
+      }
+      const NodeId p = m_tree->parent(n);
+      if (p != kNoNode && m_tree->node(n).child_slot == 0 && !refined.contains(*m_tree, p) &&
+          m_cut->can_coarsen(p) && dirichlet_exact_on(*m_tree, p, m_dirichlet, m_tolerance))
+        parents.push_back(p);
+    }
+    std::sort(parents.begin(), parents.end());
+    changes.coarsen = std::move(parents);
+    if (changes.refine.empty() && changes.coarsen.empty()) return;
+    if (initial) {
+      m_controller->apply(*m_cut, changes, 0);
+      for (NodeId parent : changes.coarsen)
+        if (m_cut->is_active(parent)) m_tree->coarsen_subtree(parent);
+    } else {
+      const VectorXd x = m_simulation->positions();
+      const VectorXd v = m_simulation->velocities();
+      change_cut(changes, pass, step_count(), x, v, m_simulation->kinetic_energy(),
+                 momentum(*m_simulation), m_simulation->plastic_state());
+    }
+  }
+}
 
 void AdaptiveSimulation::make_dirichlet_exact() {
   // Each pass refines the offending tets one level; at the deepest level every group is exact.
@@ -305,6 +355,13 @@ void AdaptiveSimulation::advance() {
     advance_with_redo();
     record_sample();
     return;
+  }
+  if (m_settings.mode == HierarchyMode::precomputed) {
+    const std::size_t w = m_settings.precomputed->window_at(time());
+    if (w != m_window) {
+      m_window = w;
+      move_to_window(w, false);
+    }
   }
   const auto start = Clock::now();
   m_estimate_valid = false;

@@ -1,21 +1,34 @@
 #include "scene_hierarchy.hpp"
 
+#include <memory>
+
+#include "strata/app/cut_file.hpp"
 #include "strata/core/common/error.hpp"
 
 namespace strata::app::detail {
 
-HierarchySettings parse_hierarchy(const SceneValue& value) {
+HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem::path& folder) {
   value.expect_object({"levels", "mode", "level", "adapt_every", "max_passes", "indicator",
                        "refine_threshold", "coarsen_tolerance", "coarsen_indicator_fraction",
                        "stress_floor", "min_steps_between_changes", "max_active_elements",
                        "max_level", "balance", "tolerance", "initial_adaptation",
-                       "in_step_refinement"});
+                       "in_step_refinement", "cut"});
   HierarchySettings settings;
   settings.levels = value.at("levels").integer(0);
   if (settings.levels > 8) value.at("levels").fail("must be at most 8");
   if (value.has("mode")) {
-    settings.mode =
-        static_cast<HierarchyMode>(value.at("mode").choice({"full", "uniform", "adaptive"}));
+    settings.mode = static_cast<HierarchyMode>(
+        value.at("mode").choice({"full", "uniform", "adaptive", "precomputed"}));
+  }
+  if (settings.mode == HierarchyMode::precomputed) {
+    if (!value.has("cut")) value.fail("mode \"precomputed\" needs \"cut\" (a cut.json file)");
+    const std::string name = value.at("cut").string();
+    if (name.empty()) value.at("cut").fail("must not be empty");
+    std::filesystem::path path(name);
+    if (!path.is_absolute()) path = folder / path;
+    settings.precomputed = std::make_shared<const PrecomputedCut>(read_cut_file(path));
+  } else if (value.has("cut")) {
+    value.at("cut").fail("only with mode \"precomputed\"");
   }
   if (value.has("level")) {
     settings.level = value.at("level").integer(0);

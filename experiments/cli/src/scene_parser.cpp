@@ -400,7 +400,8 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   }
   scene.solver = parse_solver(top.at("solver"));
   if (top.has("output")) scene.output = parse_output(top.at("output"));
-  if (top.has("hierarchy")) scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"));
+  if (top.has("hierarchy"))
+    scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"), file.parent_path());
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {
     throw SceneKeyError(file_name, "fixed",

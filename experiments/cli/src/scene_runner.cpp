@@ -186,6 +186,17 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
   block["redo_seconds"] = report.redo_seconds;
   block["initial_refinements"] = report.initial_refinements;
   block["initial_adaptation_seconds"] = report.initial_adaptation_seconds;
+  if (settings.mode == HierarchyMode::precomputed) {
+    const PrecomputedCut& cut = *settings.precomputed;
+    nlohmann::json starts = nlohmann::json::array();
+    for (const CutWindow& window : cut.windows)
+      starts.push_back(window.start);
+    block["precomputed"] = {{"cut", cut.name},
+                            {"windows", cut.windows.size()},
+                            {"window_starts", starts},
+                            {"sources", cut.sources},
+                            {"recorded_tolerance", cut.tolerance}};
+  }
   return block;
 }
 
@@ -445,12 +456,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
 
   write_frame();
   save_tables();
+  if (options.on_step && scene_simulation.adaptive()) options.on_step(*scene_simulation.adaptive());
   const long total_steps = planned_steps(scene.solver);
   ProgressBar progress(options.progress);
   try {
     while (!scene_simulation.finished()) {
       scene_simulation.advance();
       simulation = &scene_simulation.current();
+      if (options.on_step && scene_simulation.adaptive())
+        options.on_step(*scene_simulation.adaptive());
       const long step = simulation->step_count();
       if (step % scene.output.every == 0 || simulation->finished()) {
         write_frame();
@@ -482,6 +496,20 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
               << "within solver.max_plastic_passes = " << scene.solver.max_plastic_passes << " at "
               << counters.plastic_unconverged_steps << " of " << summary.steps
               << " steps (solver.plastic_tolerance " << scene.solver.plastic_tolerance << ")\n";
+  }
+  if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
+      adaptive && adaptive->settings().mode == HierarchyMode::precomputed) {
+    const ToleranceReport& report = adaptive->tolerance_report();
+    if (report.steps_over_tolerance > 0) {
+      log.flush();
+      std::cerr << "strata: warning: " << scene.file.string() << ": the estimated error exceeded "
+                << "hierarchy.tolerance " << report.tolerance << " at "
+                << report.steps_over_tolerance << " of " << summary.steps << " steps (largest "
+                << report.max_estimated_error << ") on the precomputed cut "
+                << adaptive->settings().precomputed->name
+                << ": it does not capture this scene (precompute it with these loads, or at a "
+                   "tighter --tolerance)\n";
+    }
   }
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
       adaptive && adaptive->settings().mode == HierarchyMode::adaptive) {

@@ -5,7 +5,9 @@
 ///   - full:     every node at the tree's deepest level (the reference resolution);
 ///   - uniform:  every node at one level k;
 ///   - adaptive: starting at level k, refined where the criteria ask (refinement_controller.hpp)
-///               and coarsened where children's stresses agree —
+///               and coarsened where children's stresses agree;
+///   - precomputed: the cuts of a schedule recorded from earlier runs (precomputed_cut.hpp),
+///               switched at the windows' starts, with no run-time criteria —
 /// all through the same code path: flatten the cut (tree_flatten.hpp), build its hanging-vertex
 /// embedding x = C q (hanging_constraints.hpp), and run core's Simulation on q with every
 /// integrator and the static solver unchanged (SimulationOptions). A scene therefore means the same
@@ -48,15 +50,16 @@
 #include "strata/hierarchy/active_cut.hpp"
 #include "strata/hierarchy/finest_level.hpp"
 #include "strata/hierarchy/hanging_constraints.hpp"
+#include "strata/hierarchy/precomputed_cut.hpp"
 #include "strata/hierarchy/refinement_controller.hpp"
 #include "strata/hierarchy/refinement_recovery_estimator.hpp"
 #include "strata/hierarchy/tree_point_location.hpp"
 
 namespace strata {
 
-enum class HierarchyMode { full, uniform, adaptive };
+enum class HierarchyMode { full, uniform, adaptive, precomputed };
 
-/// "full" / "uniform" / "adaptive".
+/// "full" / "uniform" / "adaptive" / "precomputed".
 std::string to_string(HierarchyMode mode);
 
 /// Settings of the hierarchy (scene key "hierarchy").
@@ -84,11 +87,13 @@ struct HierarchySettings {
   /// `criteria.refine_threshold` was given explicitly (an expert override of the tolerance rule).
   bool refine_threshold_set = false;
   RefinementSettings criteria;  ///< thresholds and hysteresis
+  /// Mode precomputed: the schedule of cuts to play back (validated against the coarse mesh).
+  std::shared_ptr<const PrecomputedCut> precomputed;
 };
 
 /// Throws InputError naming `where` ("hierarchy") and the key for invalid settings: levels ∉ 0..8,
 /// level ∉ 0..levels, adapt_every < 1, max_passes < 1, an unknown indicator, tolerance ∉ (0, 1),
-/// invalid criteria.
+/// invalid criteria, mode precomputed without a cut.
 void validate_hierarchy_settings(const HierarchySettings& settings, const std::string& where);
 
 /// One change of the active cut.
@@ -194,6 +199,8 @@ class AdaptiveSimulation final : public SimulationRun {
   double stepping_seconds() const { return m_stepping_seconds; }
   /// The tolerance, the estimates and the redo counts of the run.
   const ToleranceReport& tolerance_report() const { return m_report; }
+  /// Mode precomputed: the window of the schedule in use.
+  std::size_t precomputed_window() const { return m_window; }
 
  private:
   void make_dirichlet_exact();
@@ -208,6 +215,10 @@ class AdaptiveSimulation final : public SimulationRun {
   CutChanges decide(bool refine, bool coarsen);
   void advance_with_redo();
   void initial_adaptation();
+  /// Mode precomputed: changes the cut to window `w` of the schedule (before the first step:
+  /// `initial`, no state to carry).
+  void move_to_window(std::size_t w, bool initial);
+  std::size_t m_window = 0;
   /// The estimate of the current state; raises the run's energy scale to its energy norm.
   RecoveryEstimate estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach

@@ -4,6 +4,7 @@
 /// orient_tets), the Simulation, locates the probes, then steps to the end writing probes.csv,
 /// reactions.csv, the VTK series and stats.json into the output folder.
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -35,6 +36,9 @@ struct RunOptions {
   bool quiet = false;                ///< no info lines and no summary (warnings still print)
   bool progress = false;             ///< draw a progress bar on stderr
   std::ostream* log = nullptr;       ///< info and summary lines (nullptr: std::cout)
+  /// Scenes with a hierarchy: called with the run before the first step and after every step
+  /// (e.g. to record the active cut, precompute_command.hpp).
+  std::function<void(const AdaptiveSimulation&)> on_step;
 };
 
 struct RunSummary {
