@@ -145,7 +145,9 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   const int start_level =
       m_settings.mode == HierarchyMode::full ? m_settings.levels : m_settings.level;
   if (m_settings.mode == HierarchyMode::precomputed) {
-    validate_precomputed_cut(*m_settings.precomputed, coarse, m_settings.levels, "hierarchy.cut");
+    const std::string& name = m_settings.precomputed->name;
+    validate_precomputed_cut(*m_settings.precomputed, coarse, m_settings.levels,
+                             "hierarchy.cut" + (name.empty() ? "" : " (" + name + ")"));
     m_cut = std::make_unique<ActiveCut>(*m_tree);
   } else {
     m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, start_level));

@@ -26,7 +26,7 @@ int used_midpoint(const TetTree& tree, const std::vector<char>& used, int a, int
 }
 
 /// Marked edges of `n` as a bit set over kEdges; −1 if `n` must be red-refined (a vertex two
-/// levels finer on one of its edges).
+/// levels finer on one of its edges or inside one of its faces).
 int marked_pattern(const TetTree& tree, const std::vector<char>& used, NodeId n) {
   const std::array<int, 4>& v = tree.bey_vertices(n);
   int pattern = 0;
@@ -36,6 +36,19 @@ int marked_pattern(const TetTree& tree, const std::vector<char>& used, NodeId n)
     if (m < 0) continue;
     if (used_midpoint(tree, used, a, m) >= 0 || used_midpoint(tree, used, m, b) >= 0) return -1;
     pattern |= 1 << e;
+  }
+  // A face with three marked edges may also hold finer vertices inside it (a neighbour refined
+  // its central red triangle): the midpoints of the lines between the edge midpoints.
+  for (int k = 0; k < 4; ++k) {
+    std::array<int, 3> m{};
+    int o = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        if (i != k && j != k) m[o++] = used_midpoint(tree, used, v[i], v[j]);
+    if (m[0] < 0 || m[1] < 0 || m[2] < 0) continue;
+    if (used_midpoint(tree, used, m[0], m[1]) >= 0 || used_midpoint(tree, used, m[1], m[2]) >= 0 ||
+        used_midpoint(tree, used, m[2], m[0]) >= 0)
+      return -1;
   }
   return pattern;
 }
