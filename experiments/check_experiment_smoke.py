@@ -6,7 +6,8 @@
 Runs the sweep with --jobs 2, checks that every planned run finished with status ok and an error
 against full resolution (0 for the full run itself), that the coarsest uniform level is farther
 from full resolution than the tightest adaptive run (and an `elastic` variant, which ignores
-plasticity, more than 10× farther), that the charts (and the spec's pictures) exist, and that a
+plasticity, more than 10× farther; precomputed runs closer than the coarsest uniform level, with
+their training cost), that the charts (and the spec's pictures) exist, and that a
 second invocation resumes: it starts no run (every run.json unchanged) and rebuilds the same table.
 """
 import csv
@@ -55,6 +56,12 @@ def main():
             tightest["error"]):
         fail("ignoring plasticity (variant-elastic) is not clearly farther from full resolution "
              "than the tightest adaptive run")
+    precomputed = [row for row in rows if row["kind"] == "precomputed"]
+    for row in precomputed:
+        if not float(row["error"]) < float(by_run["uniform-0"]["error"]):
+            fail(f"{row['run']} is not closer to full resolution than uniform level 0")
+        if row["training_seconds"] == "" or not float(row["training_seconds"]) > 0.0:
+            fail(f"{row['run']}: no training cost recorded")
     for chart in ("error_vs_cost.png", "adaptive_over_time.png"):
         if os.path.getsize(os.path.join(folder, chart)) < 1000:
             fail(f"{chart} missing or empty")
@@ -75,8 +82,8 @@ def main():
         again = list(csv.DictReader(f))
     if [r["error"] for r in again] != [r["error"] for r in rows]:
         fail("resumed sweep's table differs from the first")
-    print(f"check_experiment_smoke: {len(rows)} runs ok ({len(variants)} variants), resume ran "
-          "none again")
+    print(f"check_experiment_smoke: {len(rows)} runs ok ({len(variants)} variants, "
+          f"{len(precomputed)} precomputed), resume ran none again")
 
 
 if __name__ == "__main__":

@@ -14,11 +14,21 @@ SPEC.json (paths relative to the spec file):
    "quick": {"set": {...}, "tolerances": [...]},      # the short version run with --quick
    "variants": [{"name": "springs",                   # further runs compared with the full one
                  "scene": "../scenes/other.json",     # optional: another scene (same probes
-                 "set": {...}}]}                      #   and frames), optional overrides
+                 "set": {...}}],                      #   and frames), optional overrides
+   "precomputed": {"train": [{"name": "left",         # cuts recorded by `strata precompute` from
+                              "set": {...}}],         #   the scene under other loads (overrides
+                   "windows": [1, 4],                 #   on top of the spec's), played back on
+                   "tolerance": 0.005}}               #   the spec's scene: one run per window count
 
 A variant is one more run, `variant-NAME`, charted as a point of its own: another model of the
 same scene (e.g. surface springs in place of element plasticity, on a scene without a hierarchy)
 measured against the same full-resolution run.
+
+Precomputed runs, `precomputed-wK`: the training scenes (the spec's scene with each `train` entry's
+overrides; relative paths in them are made absolute) are run once by `strata precompute --windows K
+--tolerance T` (T default: half of 0.01), and the spec's scene runs on the cut in hierarchy mode
+"precomputed" — a load the training did not see. The training cost is reported beside the run
+(`training_seconds`).
 
 Every run uses the scene's time stepping unchanged. Per run the sweep records wall and CPU time
 (of the strata process), element evaluations, Newton and CG iterations, the largest active tets
@@ -69,9 +79,9 @@ def load_spec(path, quick=False):
         fail(f"{path}: {error}")
     for key in spec:
         if key not in ("name", "scene", "tolerances", "uniform_levels", "set", "quick",
-                       "variants", "pictures"):
+                       "variants", "pictures", "precomputed"):
             fail(f"{path}: unknown key '{key}' (valid: name, scene, tolerances, uniform_levels, "
-                 "set, quick, variants, pictures)")
+                 "set, quick, variants, pictures, precomputed)")
     if "scene" not in spec:
         fail(f"{path}: 'scene' is required")
     spec["scene"] = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)),
@@ -137,6 +147,36 @@ def load_spec(path, quick=False):
             except (OSError, json.JSONDecodeError) as error:
                 fail(f"{where}.scene: {error}")
     spec["variants"] = variants
+    precomputed = spec.get("precomputed")
+    if precomputed is not None:
+        where = f"{path}: precomputed"
+        if not isinstance(precomputed, dict):
+            fail(f"{where}: must be an object")
+        for key in precomputed:
+            if key not in ("train", "windows", "tolerance"):
+                fail(f"{where}: unknown key '{key}' (valid: train, windows, tolerance)")
+        train = precomputed.get("train")
+        if not isinstance(train, list) or not train:
+            fail(f"{where}.train: a non-empty array of {{name, set}}")
+        names = set()
+        for i, entry in enumerate(train):
+            if not isinstance(entry, dict) or set(entry) - {"name", "set"}:
+                fail(f"{where}.train.{i}: an object with name and set")
+            name = entry.get("name")
+            if not isinstance(name, str) or not re.fullmatch(r"[a-z0-9_.-]+", name) \
+                    or name in names:
+                fail(f"{where}.train.{i}.name: required, unique, letters a-z, digits, '_-.'")
+            names.add(name)
+            entry.setdefault("set", {})
+            if not isinstance(entry["set"], dict):
+                fail(f"{where}.train.{i}.set: must be an object of key.path: value")
+        windows = precomputed.setdefault("windows", [1])
+        if not isinstance(windows, list) or not windows or \
+                not all(isinstance(k, int) and k >= 1 for k in windows):
+            fail(f"{where}.windows: an array of integers >= 1")
+        tolerance = precomputed.setdefault("tolerance", 0.005)
+        if not isinstance(tolerance, (int, float)) or not 0 < tolerance < 1:
+            fail(f"{where}.tolerance: a number in (0, 1)")
     pictures = spec.get("pictures")
     if pictures is not None:
         where = f"{path}: pictures"
@@ -174,11 +214,92 @@ def planned_runs(spec):
         if "scene" in variant:
             settings[SCENE_KEY] = variant["scene"]
         runs.append((f"variant-{variant['name']}", "variant", settings))
+    precomputed = spec.get("precomputed")
+    for windows in (precomputed or {}).get("windows", []):
+        runs.append((f"precomputed-w{windows}", "precomputed",
+                     {"hierarchy.mode": "precomputed", WINDOWS_KEY: windows,
+                      TRAIN_KEY: {"train": precomputed["train"],
+                                  "tolerance": precomputed["tolerance"]}}))
     return runs
 
 
 # A run's own scene file (variants), carried among its settings.
 SCENE_KEY = "@scene"
+# Precomputed runs: the window count and the training set, carried among the settings (so that
+# the run folder's hash covers them); the cut file is made from them before the run.
+WINDOWS_KEY = "@windows"
+TRAIN_KEY = "@train"
+# Scene keys holding file paths, relative to the scene's folder.
+PATH_KEYS = (("mesh", "file"), ("mesh", "surface"), ("mesh", "level_set"))
+
+
+def set_path(tree, path, value):
+    """Sets a dotted key path in a JSON tree (numeric parts index arrays), as strata's --set."""
+    parts = path.split(".")
+    node = tree
+    for i, part in enumerate(parts):
+        last = i + 1 == len(parts)
+        if isinstance(node, list):
+            index = int(part)
+            if index == len(node):
+                node.append(value if last else {})
+            elif last:
+                node[index] = value
+            node = node[index]
+        else:
+            if last:
+                node[part] = value
+            else:
+                node = node.setdefault(part, {})
+
+
+def cut_folder(args, spec, settings):
+    """Where the cut of a precomputed run and its training runs live."""
+    digest = hashlib.sha256()
+    digest.update(spec["scene_bytes"])
+    digest.update(json.dumps([spec["set"], settings[TRAIN_KEY], settings[WINDOWS_KEY]],
+                             sort_keys=True).encode())
+    return os.path.join(args.out, spec["name"], "cuts",
+                        f"w{settings[WINDOWS_KEY]}-{digest.hexdigest()[:12]}")
+
+
+def cut_for(args, spec, settings, threads):
+    """The cut file of a precomputed run, made by `strata precompute` unless it exists."""
+    training = settings[TRAIN_KEY]
+    windows = settings[WINDOWS_KEY]
+    folder = cut_folder(args, spec, settings)
+    cut = os.path.join(folder, "cut.json")
+    if os.path.exists(cut) and os.path.exists(os.path.join(folder, "precompute.json")):
+        return cut
+    os.makedirs(folder, exist_ok=True)
+    base = json.loads(spec["scene_bytes"])
+    scene_folder = os.path.dirname(spec["scene"])
+    for keys in PATH_KEYS:
+        node = base
+        for key in keys[:-1]:
+            node = node.get(key, {})
+        if isinstance(node.get(keys[-1]), str) and not os.path.isabs(node[keys[-1]]):
+            node[keys[-1]] = os.path.join(scene_folder, node[keys[-1]])
+    scenes = []
+    for entry in training["train"]:
+        scene = json.loads(json.dumps(base))
+        for key, value in list(spec["set"].items()) + list(entry["set"].items()):
+            set_path(scene, key, value)
+        scene_path = os.path.join(folder, f"{entry['name']}.json")
+        with open(scene_path, "w") as f:
+            json.dump(scene, f, indent=1)
+        scenes.append(scene_path)
+    command = [args.strata, "precompute", *scenes, "--out", cut, "--windows", str(windows),
+               "--tolerance", repr(training["tolerance"]), "--quiet"]
+    if threads > 0:
+        command += ["--threads", str(threads)]
+    start = time.monotonic()
+    result = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    if result.returncode != 0:
+        raise RuntimeError(f"strata precompute failed: {result.stderr.decode(errors='replace')}")
+    with open(os.path.join(folder, "precompute.json"), "w") as f:
+        json.dump({"command": command, "wall_seconds": time.monotonic() - start}, f, indent=1)
+    return cut
 
 
 def scene_of(spec, settings):
@@ -202,9 +323,11 @@ def command_for(args, spec, folder, settings, threads):
     if threads > 0:
         command += ["--threads", str(threads)]
     for key, value in list(spec["set"].items()) + list(settings.items()):
-        if key == SCENE_KEY:
+        if key in (SCENE_KEY, WINDOWS_KEY, TRAIN_KEY):
             continue
         command += ["--set", f"{key}={json.dumps(value)}"]
+    if WINDOWS_KEY in settings:
+        command += ["--set", f"hierarchy.cut={json.dumps(os.path.abspath(cut_for(args, spec, settings, threads)))}"]
     return command
 
 
@@ -216,7 +339,11 @@ def execute(args, spec, name, settings, threads):
         with open(marker) as f:
             return json.load(f)
     os.makedirs(folder, exist_ok=True)
-    command = command_for(args, spec, folder, settings, threads)
+    try:
+        command = command_for(args, spec, folder, settings, threads)
+    except RuntimeError as error:
+        return {"name": name, "settings": settings, "returncode": -1, "wall_seconds": 0.0,
+                "cpu_seconds": 0.0, "stderr": str(error)[-2000:]}
     start = time.monotonic()
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     stderr_text = []
@@ -315,6 +442,12 @@ def summarise(args, spec):
             row["tolerance"] = settings["hierarchy.tolerance"]
         if kind == "variant":
             row["variant"] = name[len("variant-"):]
+        if kind == "precomputed":
+            row["windows"] = settings[WINDOWS_KEY]
+            record = os.path.join(cut_folder(args, spec, settings), "precompute.json")
+            if os.path.exists(record):
+                with open(record) as f:
+                    row["training_seconds"] = json.load(f)["wall_seconds"]
         stats_path = os.path.join(folder, "stats.json")
         if os.path.exists(stats_path):
             with open(stats_path) as f:
@@ -366,7 +499,8 @@ def summarise(args, spec):
     return rows
 
 
-COLUMNS = ["run", "kind", "level", "tolerance", "variant", "status", "error", "energy_difference",
+COLUMNS = ["run", "kind", "level", "tolerance", "variant", "windows", "training_seconds", "status",
+           "error", "energy_difference",
            "estimated_error",
            "effectivity", "tolerance_met", "wall_seconds", "cpu_seconds", "speedup",
            "max_active_tets", "max_dofs", "element_evaluations", "newton_iterations",
@@ -405,6 +539,9 @@ def write_results(args, spec, rows):
                                   (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
         for r in (r for r in ok if r["kind"] == "variant" and r.get(cost)):
             axis.plot([r[cost]], [max(r["error"], 1e-6)], "D", label=r["variant"])
+        for r in (r for r in ok if r["kind"] == "precomputed" and r.get(cost)):
+            axis.plot([r[cost]], [max(r["error"], 1e-6)], "^", markersize=8,
+                      label=f"precomputed, {r['windows']} window{'s' if r['windows'] > 1 else ''}")
         full = next((r for r in rows if r["run"] == "full"), None)
         if full is not None and full.get(cost):
             axis.axvline(full[cost], color="k", linestyle=":", label="full resolution")
