@@ -18,7 +18,7 @@ ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
   m_solver.use_nested_spaces(problem.nested_spaces, m_reduction.free_dofs());
   m_inertia = &m_energy.emplace<InertiaTerm>(problem.dof_mass);
   m_energy.emplace<ElasticTerm>(problem.model);
-  if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(*problem.springs);
+  if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(problem.springs->springs());
   if (problem.has_obstacles())
     m_contact = &m_energy.emplace<ContactTerm>(*problem.obstacles, *problem.contact_points,
                                                problem.contact);

@@ -31,74 +31,30 @@ SurfaceSprings::SurfaceSprings(ConstRef<MatrixX3d> rest_positions, ConstRef<Matr
   std::mt19937 rng(settings.seed);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (const auto& edge : all)
-    if (uniform(rng) < settings.fraction) m_edges.push_back(edge);
-  if (m_edges.empty() && !all.empty()) m_edges.push_back(all.front());
-  m_rest.resize(size());
-  m_stiffness.resize(size());
+    if (uniform(rng) < settings.fraction) m_set.edges.push_back(edge);
+  if (m_set.edges.empty() && !all.empty()) m_set.edges.push_back(all.front());
+  m_set.rest.resize(size());
+  m_set.stiffness.resize(size());
   for (Index s = 0; s < size(); ++s) {
-    const auto [a, b] = m_edges[s];
-    m_rest[s] = (rest_positions.row(b) - rest_positions.row(a)).norm();
-    m_stiffness[s] = settings.youngs_modulus * m_rest[s];
+    const auto [a, b] = m_set.edges[s];
+    m_set.rest[s] = (rest_positions.row(b) - rest_positions.row(a)).norm();
+    m_set.stiffness[s] = settings.youngs_modulus * m_set.rest[s];
   }
-  m_initial_rest = m_rest;
-}
-
-double SurfaceSprings::energy(ConstRef<VectorXd> x) const {
-  double energy = 0.0;
-  for (Index s = 0; s < size(); ++s) {
-    const auto [a, b] = m_edges[s];
-    const double stretch = (x.segment<3>(3 * b) - x.segment<3>(3 * a)).norm() - m_rest[s];
-    energy += 0.5 * m_stiffness[s] * stretch * stretch;
-  }
-  return energy;
-}
-
-void SurfaceSprings::add_forces(ConstRef<VectorXd> x, VectorXd& f, double scale) const {
-  for (Index s = 0; s < size(); ++s) {
-    const auto [a, b] = m_edges[s];
-    const Vector3d d = x.segment<3>(3 * b) - x.segment<3>(3 * a);
-    const double length = d.norm();
-    if (length == 0.0) continue;
-    const Vector3d force = scale * m_stiffness[s] * (length - m_rest[s]) / length * d;
-    f.segment<3>(3 * a) += force;
-    f.segment<3>(3 * b) -= force;
-  }
-}
-
-void SurfaceSprings::add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian,
-                                 bool project_psd) const {
-  for (Index s = 0; s < size(); ++s) {
-    const auto [a, b] = m_edges[s];
-    const Vector3d d = x.segment<3>(3 * b) - x.segment<3>(3 * a);
-    const double length = d.norm();
-    if (length == 0.0) continue;
-    const Vector3d n = d / length;
-    double transverse = 1.0 - m_rest[s] / length;
-    if (project_psd) transverse = std::max(transverse, 0.0);
-    const Matrix3d nn = n * n.transpose();
-    const Matrix3d K = m_stiffness[s] * (nn + transverse * (Matrix3d::Identity() - nn));
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        hessian.coeffRef(3 * a + r, 3 * a + c) += K(r, c);
-        hessian.coeffRef(3 * b + r, 3 * b + c) += K(r, c);
-        hessian.coeffRef(3 * a + r, 3 * b + c) -= K(r, c);
-        hessian.coeffRef(3 * b + r, 3 * a + c) -= K(r, c);
-      }
-  }
+  m_initial_rest = m_set.rest;
 }
 
 Index SurfaceSprings::yield(ConstRef<VectorXd> x) {
   Index yielded = 0;
   const double limit = m_settings.yield_strain;
   for (Index s = 0; s < size(); ++s) {
-    const auto [a, b] = m_edges[s];
+    const auto [a, b] = m_set.edges[s];
     const double length = (x.segment<3>(3 * b) - x.segment<3>(3 * a)).norm();
-    const double strain = length / m_rest[s] - 1.0;
+    const double strain = length / m_set.rest[s] - 1.0;
     if (strain > limit) {
-      m_rest[s] = length / (1.0 + limit);
+      m_set.rest[s] = length / (1.0 + limit);
       ++yielded;
     } else if (strain < -limit) {
-      m_rest[s] = length / (1.0 - limit);
+      m_set.rest[s] = length / (1.0 - limit);
       ++yielded;
     }
   }
@@ -109,7 +65,7 @@ Index SurfaceSprings::yield(ConstRef<VectorXd> x) {
 double SurfaceSprings::largest_plastic_strain() const {
   double largest = 0.0;
   for (Index s = 0; s < size(); ++s)
-    largest = std::max(largest, std::abs(std::log(m_rest[s] / m_initial_rest[s])));
+    largest = std::max(largest, std::abs(std::log(m_set.rest[s] / m_initial_rest[s])));
   return largest;
 }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "strata/core/common/types.hpp"
+#include "strata/core/sim/spring_set.hpp"
 
 namespace strata {
 
@@ -41,18 +42,23 @@ class SurfaceSprings {
   SurfaceSprings(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX3i> boundary,
                  const SurfaceSpringSettings& settings);
 
-  Index size() const { return static_cast<Index>(m_edges.size()); }
-  const std::vector<std::array<int, 2>>& edges() const { return m_edges; }
-  const VectorXd& rest_lengths() const { return m_rest; }
-  const VectorXd& stiffness() const { return m_stiffness; }
+  Index size() const { return m_set.size(); }
+  const std::vector<std::array<int, 2>>& edges() const { return m_set.edges; }
+  const VectorXd& rest_lengths() const { return m_set.rest; }
+  const VectorXd& stiffness() const { return m_set.stiffness; }
+  /// The springs as they stand (rest lengths after yielding).
+  const SpringSet& springs() const { return m_set; }
 
   /// Σ ½ k (L − L₀)² at positions x (3·#V) [J].
-  double energy(ConstRef<VectorXd> x) const;
+  double energy(ConstRef<VectorXd> x) const { return m_set.energy(x); }
   /// f += scale · (−∂E/∂x) (scale −1 adds the gradient).
-  void add_forces(ConstRef<VectorXd> x, VectorXd& f, double scale = 1.0) const;
-  /// H += ∂²E/∂x² (k [n nᵀ + (1 − L₀/L)(I − n nᵀ)] per spring; with `project_psd` the second
-  /// factor is clamped at 0). H must hold every spring's vertex blocks.
-  void add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian, bool project_psd) const;
+  void add_forces(ConstRef<VectorXd> x, VectorXd& f, double scale = 1.0) const {
+    m_set.add_forces(x, f, scale);
+  }
+  /// H += ∂²E/∂x² (SpringSet::add_hessian). H must hold every spring's vertex blocks.
+  void add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian, bool project_psd) const {
+    m_set.add_hessian(x, hessian, project_psd);
+  }
 
   /// Rest lengths follow where |L/L₀ − 1| > ε_y; returns how many springs yielded.
   Index yield(ConstRef<VectorXd> x);
@@ -63,10 +69,8 @@ class SurfaceSprings {
 
  private:
   SurfaceSpringSettings m_settings;
-  std::vector<std::array<int, 2>> m_edges;
-  VectorXd m_rest;
+  SpringSet m_set;
   VectorXd m_initial_rest;
-  VectorXd m_stiffness;
   long long m_yield_events = 0;
 };
 
