@@ -4,8 +4,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Surface_mesh.h>
-#include <CGAL/extract_mean_curvature_flow_skeleton.h>
 #include <CGAL/boost/graph/helpers.h>
+#include <CGAL/extract_mean_curvature_flow_skeleton.h>
 
 #include <chrono>
 #include <limits>
@@ -32,11 +32,12 @@ CurveSkeleton curve_skeleton(const SurfaceMesh& surface, const std::string& wher
   std::vector<Mesh::Vertex_index> handles;
   handles.reserve(surface.vertices.rows());
   for (Index v = 0; v < surface.vertices.rows(); ++v)
-    handles.push_back(
-        mesh.add_vertex(Point(surface.vertices(v, 0), surface.vertices(v, 1), surface.vertices(v, 2))));
+    handles.push_back(mesh.add_vertex(
+        Point(surface.vertices(v, 0), surface.vertices(v, 1), surface.vertices(v, 2))));
   for (Index f = 0; f < surface.triangles.rows(); ++f) {
-    const auto face = mesh.add_face(handles[surface.triangles(f, 0)], handles[surface.triangles(f, 1)],
-                                    handles[surface.triangles(f, 2)]);
+    const auto face =
+        mesh.add_face(handles[surface.triangles(f, 0)], handles[surface.triangles(f, 1)],
+                      handles[surface.triangles(f, 2)]);
     if (face == Mesh::null_face())
       throw InputError(where + ": triangle " + std::to_string(f) +
                        " breaks the 2-manifold (a skeleton needs a closed manifold surface)");
@@ -79,8 +80,7 @@ CurveSkeleton curve_skeleton(const SurfaceMesh& surface, const std::string& wher
       }
     }
   }
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -26,8 +26,7 @@ void SpringSet::add_forces(ConstRef<VectorXd> x, VectorXd& f, double scale) cons
   }
 }
 
-void SpringSet::add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian,
-                                 bool project_psd) const {
+void SpringSet::add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian, bool project_psd) const {
   for (Index s = 0; s < size(); ++s) {
     const auto [a, b] = edges[s];
     const Vector3d d = x.segment<3>(3 * b) - x.segment<3>(3 * a);
