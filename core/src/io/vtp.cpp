@@ -43,4 +43,35 @@ void write_vtp(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
   });
 }
 
+void write_vtp_lines(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
+                     const std::vector<std::array<int, 2>>& segments, const VtuFields& fields) {
+  const Index num_points = positions.rows();
+  const auto num_lines = static_cast<Index>(segments.size());
+  vtk_xml::check_field_rows(path, fields, num_points, num_lines);
+  for (const auto& [a, b] : segments)
+    if (a < 0 || b < 0 || a >= num_points || b >= num_points)
+      throw InputError("cannot write '" + path.string() +
+                       "': a segment refers to a point outside 0.." +
+                       std::to_string(num_points - 1));
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "<?xml version=\"1.0\"?>\n"
+           "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\" "
+           "header_type=\"UInt64\">\n"
+           "  <PolyData>\n"
+        << "    <Piece NumberOfPoints=\"" << num_points << "\" NumberOfVerts=\"0\" NumberOfLines=\""
+        << num_lines << "\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
+    vtk_xml::write_fields_and_points(out, fields, positions);
+    out << "      <Lines>\n"
+           "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (const auto& [a, b] : segments)
+      out << "          " << a << ' ' << b << '\n';
+    out << "        </DataArray>\n"
+           "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    for (Index l = 0; l < num_lines; ++l)
+      out << (l % 16 == 0 ? "          " : " ") << 2 * (l + 1)
+          << (l % 16 == 15 || l + 1 == num_lines ? "\n" : "");
+    out << "        </DataArray>\n      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+  });
+}
+
 }  // namespace strata

@@ -42,24 +42,65 @@ Index SpringBody::count(SpringKind kind) const {
 }
 
 SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i> triangles,
-                                ConstRef<MatrixX3d> skeleton_points,
-                                const std::vector<std::array<int, 2>>& segments,
-                                ConstRef<VectorXi> owner, const Material& material,
+                                ConstRef<MatrixX3d> input_points,
+                                const std::vector<std::array<int, 2>>& input_segments,
+                                ConstRef<VectorXi> input_owner, const Material& material,
                                 const SpringBodyRule& rule, const std::string& where) {
   validate_spring_body_rule(rule, where);
-  const Index S = surface.rows(), K = skeleton_points.rows();
-  if (owner.size() != S) throw InputError(where + ": one skeleton vertex per surface vertex");
+  const Index S = surface.rows(), K0 = input_points.rows();
+  if (input_owner.size() != S) throw InputError(where + ": one skeleton vertex per surface vertex");
   for (Index i = 0; i < S; ++i)
-    if (owner[i] < 0 || owner[i] >= K)
+    if (input_owner[i] < 0 || input_owner[i] >= K0)
       throw InputError(where + ": surface vertex " + std::to_string(i) + " has no skeleton vertex");
   for (Index f = 0; f < triangles.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (triangles(f, k) < 0 || triangles(f, k) >= S)
         throw InputError(where + ": triangle " + std::to_string(f) + " has a bad vertex index");
-  for (const auto& [a, b] : segments)
-    if (a < 0 || a >= K || b < 0 || b >= K || a == b)
+  for (const auto& [a, b] : input_segments)
+    if (a < 0 || a >= K0 || b < 0 || b >= K0 || a == b)
       throw InputError(where + ": a skeleton segment has a bad vertex index");
   const double E = material.youngs_modulus;
+
+  // Segments shorter than a quarter of the mean are collapsed (their stiff springs would only
+  // spoil the conditioning): union–find over the short ones, points at their groups' means.
+  std::vector<int> group(K0);
+  for (Index k = 0; k < K0; ++k)
+    group[k] = static_cast<int>(k);
+  const auto find = [&](int k) {
+    while (group[k] != k)
+      k = group[k] = group[group[k]];
+    return k;
+  };
+  double mean_segment = 0.0;
+  for (const auto& [a, b] : input_segments)
+    mean_segment += (input_points.row(a) - input_points.row(b)).norm();
+  if (!input_segments.empty()) mean_segment /= static_cast<double>(input_segments.size());
+  for (const auto& [a, b] : input_segments)
+    if ((input_points.row(a) - input_points.row(b)).norm() < 0.25 * mean_segment)
+      group[find(a)] = find(b);
+  std::vector<int> merged(K0, -1);
+  Index K = 0;
+  for (Index k = 0; k < K0; ++k)
+    if (find(static_cast<int>(k)) == k) merged[k] = static_cast<int>(K++);
+  MatrixX3d skeleton_points = MatrixX3d::Zero(K, 3);
+  VectorXd members = VectorXd::Zero(K);
+  for (Index k = 0; k < K0; ++k) {
+    const int m = merged[find(static_cast<int>(k))];
+    skeleton_points.row(m) += input_points.row(k);
+    members[m] += 1.0;
+  }
+  for (Index m = 0; m < K; ++m)
+    skeleton_points.row(m) /= members[m];
+  std::vector<std::array<int, 2>> segments;
+  for (const auto& [a, b] : input_segments) {
+    const int u = merged[find(a)], w = merged[find(b)];
+    if (u != w) segments.push_back({std::min(u, w), std::max(u, w)});
+  }
+  std::sort(segments.begin(), segments.end());
+  segments.erase(std::unique(segments.begin(), segments.end()), segments.end());
+  VectorXi owner(S);
+  for (Index i = 0; i < S; ++i)
+    owner[i] = merged[find(input_owner[i])];
 
   SpringBody body;
   body.num_surface = S;
@@ -299,8 +340,10 @@ void SpringBodySimulation::step_implicit(double t1) {
   energy.emplace<InertiaTerm>(mass).set_step(predicted, h);
   energy.emplace<SpringTerm>(m_body.springs);
   energy.emplace<ExternalWorkTerm>(f_ext).set_load_factor(1.0);
-  const DofReduction reduction(m_pattern, m_constrained);
-  SpdSolver solver(LinearSolverKind::cholmod);
+  if (!m_reduction) {
+    m_reduction = std::make_unique<DofReduction>(m_pattern, m_constrained);
+    m_solver = std::make_unique<SpdSolver>(LinearSolverKind::cholmod);
+  }
   VectorXd q = predicted;
   VectorXd v_end = m_v;
   apply_constraints(t1, q, v_end);
@@ -320,7 +363,7 @@ void SpringBodySimulation::step_implicit(double t1) {
   settings.rest_positions = &m_rest;
   settings.energy_scale = m_body.springs.stiffness.sum() * size * size * 1e-6 +
                           std::abs(f_ext.dot(q)) + m_mass.sum() * size * size / (h * h) * 1e-6;
-  const NewtonResult result = newton_minimize(energy, reduction, solver, settings, q);
+  const NewtonResult result = newton_minimize(energy, *m_reduction, *m_solver, settings, q);
   m_newton_iterations += result.iterations;
   if (!result.converged)
     throw DivergenceError("step " + std::to_string(m_steps + 1) + " (t = " + std::to_string(t1) +
@@ -330,6 +373,25 @@ void SpringBodySimulation::step_implicit(double t1) {
   m_v = (q - m_x) / h;
   m_x = q;
   apply_constraints(t1, m_x, m_v);
+}
+
+std::vector<GroupReaction> SpringBodySimulation::reactions() const {
+  const VectorXd f = forces(m_x, m_v, time());
+  std::vector<GroupReaction> result;
+  for (const DirichletGroup& group : m_groups) {
+    GroupReaction reaction;
+    reaction.name = group.spec.name;
+    reaction.moment_center = group.moment_center;
+    for (int i : group.vertices) {
+      Vector3d r = Vector3d::Zero();
+      for (int c = 0; c < 3; ++c)
+        if (group.spec.components[c]) r[c] = -f[3 * i + c];
+      reaction.force += r;
+      reaction.moment += (m_x.segment<3>(3 * i) - group.moment_center).cross(r);
+    }
+    result.push_back(reaction);
+  }
+  return result;
 }
 
 void SpringBodySimulation::advance() {

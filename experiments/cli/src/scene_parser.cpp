@@ -95,7 +95,16 @@ MeshingOptions parse_meshing_options(const SceneValue& value) {
   return options;
 }
 
-MeshSpec parse_mesh(const SceneValue& value, const std::filesystem::path& folder) {
+/// `meshing`: a surface is tetrahedralised (its Mesh_3 keys apply); false for a body of skeleton
+/// springs, which takes the surface as it is (only "surface").
+MeshSpec parse_mesh(const SceneValue& value, const std::filesystem::path& folder,
+                    bool meshing = true) {
+  if (!meshing) {
+    value.expect_object({"surface"});
+    MeshSpec mesh;
+    mesh.surface = parse_path(value.at("surface"), folder);
+    return mesh;
+  }
   value.expect_object({"file", "box", "surface", "level_set", "grid", "implicit", "voxel_size",
                        "cell_size", "facet_size", "facet_distance", "facet_angle",
                        "radius_edge_ratio", "sharp_features", "perturb", "exude", "odt", "lloyd",
@@ -341,11 +350,39 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   const std::string file_name = file.string();
   const SceneValue top(root, "", file_name);
   top.expect_object({"mesh", "material", "gravity", "fixed", "prescribed", "forces", "ground",
-                     "obstacles", "solver", "output", "hierarchy"});
+                     "obstacles", "solver", "output", "hierarchy", "body"});
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();
-  scene.mesh = parse_mesh(top.at("mesh"), file.parent_path());
+  if (top.has("body")) {
+    const SceneValue body = top.at("body");
+    body.expect_object({"model", "shell_ratio", "surface_scale", "tie_scale", "skeleton_scale"});
+    scene.body.skeleton_springs = body.at("model").choice({"tets", "skeleton_springs"}) == 1;
+    SpringBodyRule& rule = scene.body.rule;
+    const std::pair<const char*, double*> factors[] = {{"shell_ratio", &rule.shell_ratio},
+                                                       {"surface_scale", &rule.surface_scale},
+                                                       {"tie_scale", &rule.tie_scale},
+                                                       {"skeleton_scale", &rule.skeleton_scale}};
+    for (const auto& [key, target] : factors) {
+      if (!body.has(key)) continue;
+      if (!scene.body.skeleton_springs) body.at(key).fail("only with model \"skeleton_springs\"");
+      *target = body.at(key).positive();
+    }
+    if (scene.body.skeleton_springs) {
+      if (!top.at("mesh").has("surface"))
+        body.at("model").fail("skeleton_springs needs mesh.surface (a closed surface file)");
+      for (const char* key : {"hierarchy", "obstacles"})
+        if (top.has(key))
+          throw SceneKeyError(file_name, key, "not supported with body.model skeleton_springs",
+                              false);
+      if (top.at("material").has("surface_springs") || top.at("material").has("plasticity"))
+        throw SceneKeyError(file_name, "material",
+                            "surface_springs and plasticity are not supported with body.model "
+                            "skeleton_springs",
+                            false);
+    }
+  }
+  scene.mesh = parse_mesh(top.at("mesh"), file.parent_path(), !scene.body.skeleton_springs);
   scene.material = parse_material(top.at("material"));
   if (top.at("material").has("surface_springs")) {
     scene.surface_springs = parse_surface_springs(top.at("material").at("surface_springs"));

@@ -1,5 +1,7 @@
 #include "strata/app/scene_runner.hpp"
 
+#include "spring_body_runner.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -327,6 +329,7 @@ void write_json(const std::filesystem::path& path, const nlohmann::json& value) 
 }  // namespace
 
 RunSummary run_scene(const Scene& scene, const RunOptions& options) {
+  if (scene.body.skeleton_springs) return detail::run_spring_body_scene(scene, options);
   const Clock::time_point start = Clock::now();
   std::ostream& log = options.log ? *options.log : std::cout;
   RunSummary summary;

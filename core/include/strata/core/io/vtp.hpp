@@ -3,7 +3,9 @@
 /// VTK XML PolyData (.vtp): triangle surfaces with point and cell fields for ParaView, e.g. the
 /// deformed fine surface of a run. Same conventions as vtu.hpp (ASCII, round-trip doubles, atomic).
 /// Format: https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html
+#include <array>
 #include <filesystem>
+#include <vector>
 
 #include "strata/core/io/vtu.hpp"
 
@@ -15,5 +17,10 @@ namespace strata {
 /// match #V or #F, or a triangle index is out of range.
 void write_vtp(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
                ConstRef<MatrixX3i> triangles, const VtuFields& fields = {});
+
+/// Writes line segments (`segments` #L pairs of point indices, written as Lines) as an ASCII .vtp,
+/// atomically, with point fields (#V × k) and cell fields (#L × k), e.g. a curve skeleton.
+void write_vtp_lines(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
+                     const std::vector<std::array<int, 2>>& segments, const VtuFields& fields = {});
 
 }  // namespace strata

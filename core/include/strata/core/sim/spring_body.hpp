@@ -16,12 +16,15 @@
 ///     across its ties);
 ///   - skeleton segments: the rest of the section's axial stiffness, A = ½ π r̄² (the tube carries
 ///     the other half of a solid circle's π r²), r̄ the mean tie length at the segment's ends.
+/// Skeleton segments shorter than a quarter of the mean segment length are collapsed first (their
+/// points merged at their mean).
 /// The body's mass is ρ × the enclosed volume, lumped: each surface triangle's wedge to its
 /// vertices' skeleton points (volume V_T) gives ¼ V_T to each of its corners and ¼ V_T to those
 /// skeleton points; every vertex keeps at least 1 % of the mean vertex mass, and the masses are
 /// scaled to ρ V. ν is not represented (a spring network has its own, about ⅓).
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,8 +32,11 @@
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/material.hpp"
 #include "strata/core/sim/dirichlet.hpp"
+#include "strata/core/sim/dof_reduction.hpp"
 #include "strata/core/sim/ground_contact.hpp"
+#include "strata/core/sim/linear_solver.hpp"
 #include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 #include "strata/core/sim/spring_set.hpp"
 
@@ -103,6 +109,10 @@ class SpringBodySimulation {
   double stable_dt_estimate() const { return m_stable_dt; }
   long newton_iterations() const { return m_newton_iterations; }
   const std::vector<DirichletGroup>& dirichlet_groups() const { return m_groups; }
+  /// Per Dirichlet group, the force the constraint exerts on the body, R = −Σ f over its
+  /// prescribed DOFs (f: springs, loads and damping now; the prescribed acceleration of a linear
+  /// ramp is zero), and its moment about the group's moment center.
+  std::vector<GroupReaction> reactions() const;
 
  private:
   VectorXd forces(const VectorXd& x, const VectorXd& v, double t) const;
@@ -124,6 +134,10 @@ class SpringBodySimulation {
   double m_stable_dt = 0.0;
   long m_newton_iterations = 0;
   SparseMatrixd m_pattern;
+  /// Implicit steps: the free-DOF reduction and the solver, kept so that the symbolic
+  /// factorisation is done once.
+  std::unique_ptr<DofReduction> m_reduction;
+  std::unique_ptr<SpdSolver> m_solver;
 };
 
 }  // namespace strata

@@ -15,6 +15,7 @@
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/solver_settings.hpp"
+#include "strata/core/sim/spring_body.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
 #include "strata/meshing/implicit_shape.hpp"
 #include "strata/meshing/meshing_options.hpp"
@@ -55,6 +56,13 @@ struct ObstacleSpec {
   Vector3d velocity = Vector3d::Zero();  ///< "motion": {"velocity"} [m/s]
 };
 
+/// "body": the body model — tets (the mesh; default) or skeleton springs on mesh.surface
+/// (spring_body.hpp).
+struct BodySpec {
+  bool skeleton_springs = false;
+  SpringBodyRule rule;
+};
+
 /// "output".
 struct OutputSpec {
   int every = 1;                 ///< write a frame every this many steps (and after the last)
@@ -83,6 +91,7 @@ struct Scene {
   /// adaptive); absent: the mesh itself, as a plain Simulation.
   std::optional<HierarchySettings> hierarchy;
   std::vector<ObstacleSpec> obstacles;
+  BodySpec body;
 
   /// fixed groups first, then prescribed ones: the order of reactions.csv's `group` column.
   std::vector<DirichletSpec> dirichlet_groups() const;

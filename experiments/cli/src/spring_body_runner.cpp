@@ -1,0 +1,235 @@
+#include "spring_body_runner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "strata/app/progress_bar.hpp"
+#include "strata/app/run_outputs.hpp"
+#include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
+#include "strata/core/io/atomic_file.hpp"
+#include "strata/core/io/pvd.hpp"
+#include "strata/core/io/vtp.hpp"
+#include "strata/meshing/curve_skeleton.hpp"
+#include "strata/meshing/surface_io.hpp"
+
+namespace strata::app::detail {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Each probe's nearest body vertex at rest; a probe farther than 5 % of the body's bounding-box
+/// diagonal from every vertex is an error naming it.
+std::vector<Index> locate_probes(const Scene& scene, const SpringBody& body) {
+  const double diagonal = (body.rest.colwise().maxCoeff() - body.rest.colwise().minCoeff()).norm();
+  std::vector<Index> nearest;
+  for (std::size_t p = 0; p < scene.output.probes.size(); ++p) {
+    Index best = 0;
+    (body.rest.rowwise() - scene.output.probes[p].transpose())
+        .rowwise()
+        .squaredNorm()
+        .minCoeff(&best);
+    const double distance = (body.rest.row(best).transpose() - scene.output.probes[p]).norm();
+    if (distance > 0.05 * diagonal) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    ": output.probes.%zu: (%g, %g, %g) is %g m from the body's nearest vertex "
+                    "(at most 5 %% of its size, %g m)",
+                    p, scene.output.probes[p].x(), scene.output.probes[p].y(),
+                    scene.output.probes[p].z(), distance, 0.05 * diagonal);
+      throw InputError(scene.file.string() + text);
+    }
+    nearest.push_back(best);
+  }
+  return nearest;
+}
+
+}  // namespace
+
+RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) {
+  const Clock::time_point start = Clock::now();
+  std::ostream& log = options.log ? *options.log : std::cout;
+  RunSummary summary;
+  summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
+  const std::string where = scene.file.string() + ": mesh.surface";
+  SurfaceMesh surface;
+  try {
+    surface = read_surface(*scene.mesh.surface);
+  } catch (const InputError& error) {
+    throw InputError(where + ": " + error.what());
+  }
+  const CurveSkeleton skeleton = curve_skeleton(surface, where);
+  std::vector<std::array<int, 2>> segments;
+  for (Index e = 0; e < skeleton.edges.rows(); ++e)
+    segments.push_back({skeleton.edges(e, 0), skeleton.edges(e, 1)});
+  std::unique_ptr<SpringBodySimulation> run;
+  try {
+    SpringBody body =
+        skeleton_spring_body(surface.vertices, surface.triangles, skeleton.points, segments,
+                             skeleton.owner, scene.material, scene.body.rule, "body");
+    run = std::make_unique<SpringBodySimulation>(std::move(body), scene.material,
+                                                 scene.dirichlet_groups(), scene.forces,
+                                                 scene.ground, scene.gravity, scene.solver);
+  } catch (const InputError& error) {
+    throw InputError(scene.file.string() + ": " + error.what());
+  }
+  const SpringBody& body = run->body();
+  const std::vector<Index> probe_vertices = locate_probes(scene, body);
+  const long total_steps =
+      static_cast<long>(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9));
+  if (!options.quiet) {
+    log << "strata: " << scene.file.string() << ": skeleton springs on "
+        << scene.mesh.surface->string() << ": " << body.num_surface << " surface vertices, "
+        << body.rest.rows() - body.num_surface << " skeleton points (skeletonized in "
+        << format_duration(skeleton.seconds) << "), " << body.springs.size() << " springs ("
+        << body.count(SpringKind::surface) << " surface, " << body.count(SpringKind::tie)
+        << " ties, " << body.count(SpringKind::skeleton) << " skeleton), mass "
+        << body.vertex_mass.sum() << " kg, " << to_string(scene.solver.integrator) << ", dt "
+        << scene.solver.dt << " s, " << total_steps << " steps\n";
+    if (scene.solver.integrator != Integrator::implicit_euler)
+      log << "strata: stable dt estimate " << run->stable_dt_estimate() << " s\n";
+  }
+  if (scene.solver.integrator != Integrator::implicit_euler &&
+      scene.solver.dt > run->stable_dt_estimate()) {
+    log.flush();
+    std::cerr << "strata: warning: dt = " << scene.solver.dt << " s exceeds the stable estimate "
+              << run->stable_dt_estimate() << " s of " << to_string(scene.solver.integrator)
+              << "; the run will likely diverge\n";
+  }
+  log.flush();
+
+  std::filesystem::create_directories(summary.output_dir);
+  CsvSeries probes(summary.output_dir / "probes.csv", "time,probe,x,y,z,ux,uy,uz");
+  ReactionRecorder reactions(summary.output_dir / "reactions.csv");
+  std::optional<PvdWriter> pvd;
+  if (scene.output.vtk) pvd.emplace(summary.output_dir / (scene.name + ".pvd"));
+  const Index S = body.num_surface;
+  const Index V = body.rest.rows();
+  double max_displacement = 0.0;
+  const auto write_frame = [&]() {
+    const double t = run->time();
+    const VectorXd& x = run->positions();
+    MatrixX3d positions(V, 3), displacement(V, 3), velocity(V, 3);
+    for (Index i = 0; i < V; ++i) {
+      positions.row(i) = x.segment<3>(3 * i).transpose();
+      displacement.row(i) = positions.row(i) - body.rest.row(i);
+      velocity.row(i) = run->velocities().segment<3>(3 * i).transpose();
+    }
+    max_displacement = std::max(max_displacement, displacement.rowwise().norm().maxCoeff());
+    for (std::size_t p = 0; p < probe_vertices.size(); ++p) {
+      std::ostringstream row;
+      row << format_double(t) << ',' << p;
+      for (int c = 0; c < 3; ++c)
+        row << ',' << format_double(scene.output.probes[p][c]);
+      for (int c = 0; c < 3; ++c)
+        row << ',' << format_double(displacement(probe_vertices[p], c));
+      probes.add_row(row.str());
+    }
+    reactions.record(t, run->reactions());
+    if (pvd) {
+      char name[48];
+      std::snprintf(name, sizeof name, "_%06d.vtp", summary.frames);
+      VtuFields surface_fields;
+      surface_fields.add_point_data("displacement", displacement.topRows(S));
+      surface_fields.add_point_data("velocity", velocity.topRows(S));
+      write_vtp(summary.output_dir / (scene.name + name), positions.topRows(S), body.triangles,
+                surface_fields);
+      pvd->add_frame(t, scene.name + name, 0);
+      std::vector<std::array<int, 2>> lines;
+      for (const auto& [a, b] : body.skeleton_segments)
+        lines.push_back({static_cast<int>(a - S), static_cast<int>(b - S)});
+      VtuFields skeleton_fields;
+      skeleton_fields.add_point_data("displacement", displacement.bottomRows(V - S));
+      std::snprintf(name, sizeof name, "_skeleton_%06d.vtp", summary.frames);
+      write_vtp_lines(summary.output_dir / (scene.name + name), positions.bottomRows(V - S), lines,
+                      skeleton_fields);
+      pvd->add_frame(t, scene.name + name, 1);
+    }
+    ++summary.frames;
+  };
+  const auto finish = [&]() {
+    probes.save();
+    reactions.csv().save();
+    summary.steps = run->step_count();
+    summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    summary.stable_dt_estimate = run->stable_dt_estimate();
+    nlohmann::json stats;
+    stats["status"] = summary.status;
+    if (!summary.message.empty()) stats["message"] = summary.message;
+    stats["scene"] = scene.file.string();
+    stats["body"] = "skeleton_springs";
+    stats["wall_seconds"] = summary.wall_seconds;
+    stats["steps"] = summary.steps;
+    stats["frames"] = summary.frames;
+    stats["newton_iterations"] = run->newton_iterations();
+    stats["threads"] = max_threads();
+    stats["mode"] = "dynamic";
+    stats["integrator"] = to_string(scene.solver.integrator);
+    stats["dt"] = scene.solver.dt;
+    stats["duration"] = scene.solver.duration;
+    stats["final_time"] = run->time();
+    stats["stable_dt_estimate"] = run->stable_dt_estimate();
+    stats["vertices"] = V;
+    stats["tets"] = 0;
+    stats["dofs"] = 3 * V;
+    stats["skeleton"] = {{"surface_vertices", S},
+                         {"skeleton_points", V - S},
+                         {"segments", body.skeleton_segments.size()},
+                         {"seconds", skeleton.seconds},
+                         {"springs",
+                          {{"surface", body.count(SpringKind::surface)},
+                           {"ties", body.count(SpringKind::tie)},
+                           {"skeleton", body.count(SpringKind::skeleton)}}},
+                         {"rule",
+                          {{"shell_ratio", scene.body.rule.shell_ratio},
+                           {"surface_scale", scene.body.rule.surface_scale},
+                           {"tie_scale", scene.body.rule.tie_scale},
+                           {"skeleton_scale", scene.body.rule.skeleton_scale}}},
+                         {"mass", body.vertex_mass.sum()},
+                         {"volume", body.volume}};
+    stats["energies"] = {{"elastic", run->elastic_energy()},
+                         {"kinetic", run->kinetic_energy()},
+                         {"external_potential", run->external_potential_energy()}};
+    stats["max_displacement"] = max_displacement;
+    stats["probes"] = scene.output.probes.size();
+    write_file_atomically(summary.output_dir / "stats.json",
+                          [&stats](std::ostream& out) { out << stats.dump(2) << '\n'; });
+  };
+
+  write_frame();
+  ProgressBar progress(options.progress);
+  try {
+    while (!run->finished()) {
+      run->advance();
+      const long step = run->step_count();
+      if (step % scene.output.every == 0 || run->finished()) {
+        write_frame();
+        probes.save_if_due();
+        reactions.csv().save_if_due();
+      }
+      char label[64];
+      std::snprintf(label, sizeof label, "t = %.4g s", run->time());
+      progress.update(static_cast<double>(step) / static_cast<double>(total_steps), label);
+    }
+  } catch (const DivergenceError& error) {
+    progress.clear();
+    summary.status = "diverged";
+    summary.message = error.what();
+    finish();
+    throw;
+  }
+  progress.clear();
+  finish();
+  if (!options.quiet)
+    log << "strata: done: " << summary.steps << " steps, " << summary.frames << " frames in "
+        << format_duration(summary.wall_seconds) << "; output in " << summary.output_dir.string()
+        << "\n";
+  return summary;
+}
+
+}  // namespace strata::app::detail

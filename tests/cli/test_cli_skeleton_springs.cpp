@@ -1,0 +1,116 @@
+// Scenes with "body": {"model": "skeleton_springs"} end to end: a cantilever of springs on a bar
+// surface and its skeleton, at rest under its tip load (the clamp's reaction balances the load),
+// the outputs (probes, reactions, surface and skeleton frames, stats), and the errors for
+// scenes the model does not support.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cli_test_utils.hpp"
+#include "surface_test_utils.hpp"
+
+namespace strata::cli_test {
+namespace {
+
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+json cantilever() {
+  return json::parse(R"({
+    "mesh": {"surface": "bar.off"},
+    "body": {"model": "skeleton_springs"},
+    "material": {"model": "neohookean", "youngs_modulus": 1e6, "poisson_ratio": 0.3,
+                 "density": 1.0, "damping": {"mass": 6.0}},
+    "fixed": [{"box": {"min": [-1, -1, -1], "max": [0.02, 1, 1]}}],
+    "forces": [{"region": {"box": {"min": [1, -1, -1], "max": [2, 1, 1]}},
+                "total_force": [0, 0, -0.05]}],
+    "solver": {"mode": "dynamic", "integrator": "implicit_euler", "dt": 0.05, "duration": 10},
+    "output": {"every": 20, "probes": [[1, 0.1, 0.1], [0.5, 0.1, 0.2]]}
+  })");
+}
+
+TEST(CliSkeletonSprings, ACantileverComesToRestAndWritesItsOutputs) {
+  const TempFolder folder;
+  MatrixX3d vertices;
+  write_text(folder.path() / "bar.off", bar_off(vertices));
+  write_text(folder.path() / "beam.json", cantilever().dump(2));
+  const CliResult result = run_strata("run beam.json", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out, HasSubstr("skeleton springs on bar.off"));
+  const std::filesystem::path out = folder.path() / "out" / "beam";
+  const json stats = read_json(out / "stats.json");
+  EXPECT_EQ(stats["body"], "skeleton_springs");
+  EXPECT_EQ(stats["skeleton"]["surface_vertices"], vertices.rows());
+  EXPECT_GT(stats["skeleton"]["skeleton_points"].get<int>(), 5);
+  EXPECT_NEAR(stats["skeleton"]["mass"].get<double>(), 1.0 * 0.04, 1e-12);
+  // At rest, the clamp holds the load: R = −F.
+  const Csv reactions = read_csv(out / "reactions.csv");
+  ASSERT_FALSE(reactions.rows.empty());
+  const std::vector<double>& last = reactions.rows.back();
+  EXPECT_NEAR(last[2], 0.0, 1e-4);
+  EXPECT_NEAR(last[4], 0.05, 0.05 * 0.01);
+  // The tip (the probe at the end face's centre is a surface vertex) deflects as the stiffness
+  // rule predicts, within its stated factor of 1.5 of Euler–Bernoulli, F L³ / (3 E I).
+  const Csv probes = read_csv(out / "probes.csv");
+  ASSERT_EQ(probes.rows.size(), 2u * 11u);  // frames at t = 0, 1, …, 10 s
+  const double predicted = 0.05 / (3.0 * 1e6 * std::pow(0.2, 4) / 12.0);
+  const double tip = -probes.rows[probes.rows.size() - 2][7];
+  EXPECT_GT(tip, predicted / 1.5);
+  EXPECT_LT(tip, predicted * 1.5);
+  // Surface (part 0) and skeleton (part 1) frames.
+  const std::string pvd = read_text(out / "beam.pvd");
+  EXPECT_THAT(pvd, HasSubstr("beam_000010.vtp"));
+  EXPECT_THAT(pvd, HasSubstr("beam_skeleton_000010.vtp"));
+  EXPECT_THAT(read_text(out / "beam_skeleton_000010.vtp"), HasSubstr("<Lines>"));
+  EXPECT_EQ(read_vtp_points(out / "beam_000010.vtp").rows(), vertices.rows());
+}
+
+TEST(CliSkeletonSprings, UnsupportedScenesGetOneLineErrors) {
+  const TempFolder folder;
+  MatrixX3d vertices;
+  std::string off = bar_off(vertices);
+  write_text(folder.path() / "bar.off", off);
+  // An open surface: the last triangle dropped.
+  off = off.substr(0, off.rfind("3 ", off.size() - 2));
+  const std::size_t header = off.find('\n') + 1;
+  const std::string counts = off.substr(header, off.find('\n', header) - header);
+  const long faces = std::stol(counts.substr(counts.find(' ') + 1));
+  off.replace(header, counts.size(),
+              std::to_string(vertices.rows()) + " " + std::to_string(faces - 1) + " 0");
+  write_text(folder.path() / "open.off", off);
+  const auto error = [&](const json& scene) {
+    write_text(folder.path() / "bad.json", scene.dump(2));
+    const CliResult result = run_strata("run bad.json -q", folder.path());
+    EXPECT_EQ(result.exit_code, 2) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    return result.err;
+  };
+  json scene = cantilever();
+  scene["mesh"] = {{"box", {{"min", {0, 0, 0}}, {"max", {1, 1, 1}}, {"cells", {1, 1, 1}}}}};
+  EXPECT_THAT(error(scene), HasSubstr("body.model: skeleton_springs needs mesh.surface"));
+  scene = cantilever();
+  scene["hierarchy"] = {{"levels", 1}};
+  EXPECT_THAT(error(scene), HasSubstr("hierarchy: not supported with body.model"));
+  scene = cantilever();
+  scene["solver"] = {{"mode", "static"}};
+  EXPECT_THAT(error(scene), HasSubstr("runs dynamic only"));
+  scene = cantilever();
+  scene["body"] = {{"model", "tets"}, {"tie_scale", 2}};
+  EXPECT_THAT(error(scene), HasSubstr("body.tie_scale: only with model \"skeleton_springs\""));
+  scene = cantilever();
+  scene["body"]["shell_ratio"] = -1;
+  EXPECT_THAT(error(scene), HasSubstr("body.shell_ratio"));
+  scene = cantilever();
+  scene["mesh"]["cell_size"] = 0.1;
+  EXPECT_THAT(error(scene), HasSubstr("mesh.cell_size"));
+  scene = cantilever();
+  scene["mesh"]["surface"] = "open.off";
+  EXPECT_THAT(error(scene), HasSubstr("mesh.surface: the surface has holes"));
+  scene = cantilever();
+  scene["output"]["probes"] = {{5, 5, 5}};
+  EXPECT_THAT(error(scene), HasSubstr("output.probes.0"));
+}
+
+}  // namespace
+}  // namespace strata::cli_test
