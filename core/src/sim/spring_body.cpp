@@ -16,15 +16,6 @@
 #include "strata/core/sim/region.hpp"
 
 namespace strata {
-namespace {
-
-std::string format_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
-
-}  // namespace
 
 void validate_spring_body_rule(const SpringBodyRule& rule, const std::string& where) {
   const auto check = [&](double value, const char* key) {
@@ -329,8 +320,28 @@ void SpringBodySimulation::step_explicit(double t1) {
 }
 
 void SpringBodySimulation::step_implicit(double t1) {
+  // A step whose Newton solve fails is retried as 2, 4, 8, 16 substeps from its start.
+  if (try_implicit(t1, m_settings.dt)) return;
+  const VectorXd x0 = m_x, v0 = m_v;
+  for (int n = 2; n <= 16; n *= 2) {
+    bool ok = true;
+    for (int k = 1; k <= n && ok; ++k)
+      ok = try_implicit(t1 - m_settings.dt + k * m_settings.dt / n, m_settings.dt / n);
+    if (ok) {
+      ++m_substepped_steps;
+      return;
+    }
+    m_x = x0;
+    m_v = v0;
+  }
+  throw DivergenceError("step " + std::to_string(m_steps + 1) + " (t = " + std::to_string(t1) +
+                            " s): Newton did not converge, nor in 16 substeps",
+                        m_steps + 1, t1);
+}
+
+bool SpringBodySimulation::try_implicit(double t1, double h) {
   // Backward Euler with mass damping: (1 + αh)/h² M (q − q̃) = f(q), q̃ = x + h v/(1 + αh).
-  const double h = m_settings.dt, alpha = m_material.mass_damping;
+  const double alpha = m_material.mass_damping;
   const VectorXd mass = (1.0 + alpha * h) * m_mass;
   const VectorXd predicted = m_x + h / (1.0 + alpha * h) * m_v;
   VectorXd f_ext = m_loads.base;
@@ -365,14 +376,11 @@ void SpringBodySimulation::step_implicit(double t1) {
                           std::abs(f_ext.dot(q)) + m_mass.sum() * size * size / (h * h) * 1e-6;
   const NewtonResult result = newton_minimize(energy, *m_reduction, *m_solver, settings, q);
   m_newton_iterations += result.iterations;
-  if (!result.converged)
-    throw DivergenceError("step " + std::to_string(m_steps + 1) + " (t = " + std::to_string(t1) +
-                              " s): Newton did not converge (residual " +
-                              format_number(result.residual) + " N)",
-                          m_steps + 1, t1);
+  if (!result.converged) return false;
   m_v = (q - m_x) / h;
   m_x = q;
   apply_constraints(t1, m_x, m_v);
+  return true;
 }
 
 std::vector<GroupReaction> SpringBodySimulation::reactions() const {

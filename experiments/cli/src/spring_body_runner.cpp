@@ -167,6 +167,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     stats["steps"] = summary.steps;
     stats["frames"] = summary.frames;
     stats["newton_iterations"] = run->newton_iterations();
+    stats["substepped_steps"] = run->substepped_steps();
     stats["threads"] = max_threads();
     stats["mode"] = "dynamic";
     stats["integrator"] = to_string(scene.solver.integrator);

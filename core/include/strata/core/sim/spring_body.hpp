@@ -80,8 +80,9 @@ SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i>
 /// Runs a SpringBody with the dynamic integrators (implicit Euler by Newton on the incremental
 /// potential, symplectic Euler, RK4), gravity, region loads (on the surface triangles), Dirichlet
 /// groups (any body vertex in the region), Rayleigh mass damping α and the ground (projection
-/// after each step, as for tet meshes). Static mode and stiffness damping are not offered: a
-/// spring body has floppy modes no static solve can pin down.
+/// after each step, as for tet meshes). An implicit step whose Newton solve fails is retried from
+/// its start as 2, 4, 8 or 16 substeps (outputs stay on the scene's time grid). Static mode and
+/// stiffness damping are not offered: a spring body has floppy modes no static solve can pin down.
 class SpringBodySimulation {
  public:
   /// Throws InputError for static mode, stiffness damping, invalid regions or loads.
@@ -108,6 +109,8 @@ class SpringBodySimulation {
   /// Largest stable step of the explicit integrators (Gershgorin bound of M⁻¹K at rest) [s].
   double stable_dt_estimate() const { return m_stable_dt; }
   long newton_iterations() const { return m_newton_iterations; }
+  /// Implicit steps whose Newton solve failed and that were taken as substeps instead.
+  long substepped_steps() const { return m_substepped_steps; }
   const std::vector<DirichletGroup>& dirichlet_groups() const { return m_groups; }
   /// Per Dirichlet group, the force the constraint exerts on the body, R = −Σ f over its
   /// prescribed DOFs (f: springs, loads and damping now; the prescribed acceleration of a linear
@@ -117,6 +120,9 @@ class SpringBodySimulation {
  private:
   VectorXd forces(const VectorXd& x, const VectorXd& v, double t) const;
   void step_implicit(double t1);
+  /// One backward-Euler step of length h ending at t1; false (state unchanged) if Newton fails.
+  bool try_implicit(double t1, double h);
+  long m_substepped_steps = 0;
   void step_explicit(double t1);
   void apply_constraints(double t, VectorXd& x, VectorXd& v) const;
 
