@@ -7,10 +7,11 @@
 /// An edge of an active tet is *marked* when its midpoint is a corner of some active tet (a finer
 /// neighbour refined it). Closure: an active tet with a vertex two levels finer on an edge (a
 /// marked edge whose halves are marked in turn) or inside a face (between the midpoints of a face
-/// whose three edges are marked) is red-refined in the cut, repeated until none is left. Then each face is split by its marked edges alone — one: from the midpoint to the
-/// opposite corner; three: its four red triangles; two: the corner triangle between them and the
-/// rest along a diagonal chosen from the face's vertex ids — so both neighbours split a shared face
-/// alike, and every tet is written as
+/// whose three edges are marked) is red-refined in the cut, repeated until none is left. Then each
+/// face is split by its marked edges alone — one: from the midpoint to the opposite corner; three:
+/// its four red triangles; two: the corner triangle between them and the rest along a diagonal
+/// chosen from the face's vertex ids — so both neighbours split a shared face alike, and every tet
+/// is written as
 ///   - no marked edge:             itself;
 ///   - one marked edge ab (m):     the two halves (a, m, c, d), (m, b, c, d);
 ///   - the three edges of a face:  the face's four red triangles, each joined to the apex;
