@@ -58,6 +58,17 @@ std::uint64_t node_key(const NodePath& path) {
   return key;
 }
 
+std::uint64_t node_key(const TetTree& tree, NodeId n) {
+  const int level = tree.level(n);
+  std::uint64_t key = static_cast<std::uint64_t>(static_cast<std::uint32_t>(tree.node(n).root))
+                      << 32;
+  key |= static_cast<std::uint64_t>(level) << 24;
+  for (NodeId m = n; tree.parent(m) != kNoNode; m = tree.parent(m))
+    if (tree.level(m) <= 8)
+      key |= static_cast<std::uint64_t>(tree.node(m).child_slot) << (3 * (tree.level(m) - 1));
+  return key;
+}
+
 NodePath key_path(std::uint64_t key) {
   NodePath path;
   path.root = static_cast<int>(key >> 32);
@@ -136,7 +147,7 @@ bool RefinedSet::contains(const NodePath& path) const {
 }
 
 bool RefinedSet::contains(const TetTree& tree, NodeId n) const {
-  return contains(node_path(tree, n));
+  return m_keys.count(node_key(tree, n)) > 0;
 }
 
 std::vector<NodeId> cut_nodes(TetTree& tree, const std::vector<NodePath>& refined) {
@@ -167,10 +178,9 @@ void CutRecorder::record(const ActiveCut& cut, double time) {
   m_end = std::max(m_end, time);
   for (NodeId n : cut.nodes()) {
     for (NodeId p = tree.parent(n); p != kNoNode; p = tree.parent(p)) {
-      const std::uint64_t key = node_key(node_path(tree, p));
-      auto [it, inserted] = m_spans.try_emplace(key, Span{time, time});
+      auto [it, inserted] = m_spans.try_emplace(node_key(tree, p), Span{time, time});
       if (!inserted) {
-        if (it->second.last == time && it->second.first <= time) break;  // ancestors done too
+        if (it->second.last == time) break;  // touched at this time: its ancestors were too
         it->second.first = std::min(it->second.first, time);
         it->second.last = std::max(it->second.last, time);
       }

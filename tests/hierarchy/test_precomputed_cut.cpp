@@ -55,6 +55,7 @@ TEST(PrecomputedCut, NodePathsRoundTrip) {
     EXPECT_EQ(path.root, tree.node(n).root);
     EXPECT_EQ(parse_node_path(to_string(path), "x"), path);
     EXPECT_EQ(key_path(node_key(path)), path);
+    EXPECT_EQ(node_key(tree, n), node_key(path));
   }
   EXPECT_EQ(to_string(NodePath{12, {3, 0, 5}}), "12.305");
   EXPECT_EQ(parse_node_path("7", "x"), (NodePath{7, {}}));

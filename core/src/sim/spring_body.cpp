@@ -14,6 +14,7 @@
 #include "strata/core/sim/linear_solver.hpp"
 #include "strata/core/sim/newton_solver.hpp"
 #include "strata/core/sim/region.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
 
 namespace strata {
 
@@ -137,7 +138,7 @@ SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i>
   std::vector<double> rest, stiffness;
   const auto add = [&](int a, int b, double k, SpringKind kind) {
     const double length = (body.rest.row(a) - body.rest.row(b)).norm();
-    if (!(length > 1e-12 * (1.0 + mean_tie)) || !(k > 0.0)) return;
+    if (!(length > 1e-12 * mean_tie) || !(k > 0.0)) return;
     springs.edges.push_back({a, b});
     rest.push_back(length);
     stiffness.push_back(k);
@@ -252,8 +253,7 @@ SpringBodySimulation::SpringBodySimulation(SpringBody body, const Material& mate
     for (int i : m_body.springs.edges[s])
       stiffness_sum[i] += 2.0 * m_body.springs.stiffness[s];
   const double omega2 = stiffness_sum.cwiseQuotient(m_body.vertex_mass).maxCoeff();
-  m_stable_dt = 2.0 / std::sqrt(omega2);
-  if (m_settings.integrator == Integrator::rk4) m_stable_dt *= 2.785 / 2.0;
+  m_stable_dt = explicit_stability_interval(m_settings.integrator) / std::sqrt(omega2);
   std::vector<Eigen::Triplet<double>> triplets;
   m_body.springs.add_pattern(triplets);
   for (Index i = 0; i < 3 * V; ++i)

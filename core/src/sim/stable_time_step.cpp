@@ -30,11 +30,14 @@ double max_angular_frequency_bound(ConstRef<MatrixX3d> positions, ConstRef<Matri
                    material.density);
 }
 
+double explicit_stability_interval(Integrator integrator) {
+  return integrator == Integrator::rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
+}
+
 double stable_time_step_estimate(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
                                  const Material& material, Integrator integrator) {
-  const double omega = max_angular_frequency_bound(positions, tets, material);
-  const double stability_interval = integrator == Integrator::rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
-  return stability_interval / omega;
+  return explicit_stability_interval(integrator) /
+         max_angular_frequency_bound(positions, tets, material);
 }
 
 double mean_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets) {

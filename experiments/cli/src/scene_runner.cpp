@@ -501,30 +501,24 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
               << " steps (solver.plastic_tolerance " << scene.solver.plastic_tolerance << ")\n";
   }
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
-      adaptive && adaptive->settings().mode == HierarchyMode::precomputed) {
+      adaptive && (adaptive->settings().mode == HierarchyMode::adaptive ||
+                   adaptive->settings().mode == HierarchyMode::precomputed)) {
     const ToleranceReport& report = adaptive->tolerance_report();
     if (report.steps_over_tolerance > 0) {
       log.flush();
       std::cerr << "strata: warning: " << scene.file.string() << ": the estimated error exceeded "
                 << "hierarchy.tolerance " << report.tolerance << " at "
                 << report.steps_over_tolerance << " of " << summary.steps << " steps (largest "
-                << report.max_estimated_error << ") on the precomputed cut "
-                << adaptive->settings().precomputed->name
-                << ": it does not capture this scene (precompute it with these loads, or at a "
-                   "tighter --tolerance)\n";
-    }
-  }
-  if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
-      adaptive && adaptive->settings().mode == HierarchyMode::adaptive) {
-    const ToleranceReport& report = adaptive->tolerance_report();
-    if (report.steps_over_tolerance > 0) {
-      log.flush();
-      std::cerr << "strata: warning: " << scene.file.string() << ": the estimated error exceeded "
-                << "hierarchy.tolerance " << report.tolerance << " at "
-                << report.steps_over_tolerance << " of " << summary.steps << " steps (largest "
-                << report.max_estimated_error << "; " << report.refused_refinements
-                << " refinements refused by max_level, max_active_elements, the explicit step "
-                   "limit or hysteresis)\n";
+                << report.max_estimated_error;
+      if (adaptive->settings().mode == HierarchyMode::precomputed) {
+        std::cerr << ") on the precomputed cut " << adaptive->settings().precomputed->name
+                  << ": it does not capture this scene (precompute it with these loads, or at a "
+                     "tighter --tolerance)\n";
+      } else {
+        std::cerr << "; " << report.refused_refinements
+                  << " refinements refused by max_level, max_active_elements, the explicit step "
+                     "limit or hysteresis)\n";
+      }
     }
   }
   if (!options.quiet) {

@@ -114,6 +114,8 @@ class CutRecorder {
 
 /// A node's path packed into 64 bits (root: 32 bits, level: 8, slots: 3 bits each).
 std::uint64_t node_key(const NodePath& path);
+/// node_key(node_path(tree, n)) without building the path.
+std::uint64_t node_key(const TetTree& tree, NodeId n);
 NodePath key_path(std::uint64_t key);
 
 }  // namespace strata

@@ -20,6 +20,10 @@ namespace strata {
 double max_angular_frequency_bound(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
                                    const Material& material);
 
+/// ω_max dt bound of a stable step: 2 (symplectic Euler and, as the reference explicit limit,
+/// backward Euler), 2√2 (RK4, its stability interval on the imaginary axis).
+double explicit_stability_interval(Integrator integrator);
+
 /// Largest step [s] for which `integrator` is stable on the linearised problem at rest:
 /// 2/ω (symplectic Euler), 2√2/ω (RK4). Backward Euler is unconditionally stable; for it the
 /// symplectic Euler value is returned as the reference explicit limit.
