@@ -183,9 +183,10 @@ def load_spec(path, quick=False):
         if not isinstance(pictures, dict):
             fail(f"{where}: must be an object")
         for key in pictures:
-            if key not in ("run", "frames", "titles", "fields", "exaggerate", "view"):
+            if key not in ("run", "frames", "titles", "fields", "exaggerate", "view", "up",
+                           "gif"):
                 fail(f"{where}: unknown key '{key}' (valid: run, frames, titles, fields, "
-                     "exaggerate, view)")
+                     "exaggerate, view, up, gif)")
         if pictures.get("run") not in [r[0] for r in planned_runs(spec)]:
             fail(f"{where}.run: must name a run of the sweep (see --list)")
         frames = pictures.setdefault("frames", [1.0])
@@ -197,6 +198,11 @@ def load_spec(path, quick=False):
         pictures.setdefault("fields", ["von_mises"])
         pictures.setdefault("exaggerate", 1.0)
         pictures.setdefault("view", [22.0, -60.0])
+        if pictures.setdefault("up", "z") not in ("x", "y", "z"):
+            fail(f"{where}.up: one of \"x\", \"y\", \"z\"")
+        gif = pictures.get("gif")
+        if gif is not None and not isinstance(gif, str):
+            fail(f"{where}.gif: the field to animate (e.g. \"level\")")
     return spec
 
 
@@ -401,10 +407,25 @@ def draw_pictures(args, spec):
                "--out", os.path.join(args.out, spec["name"], "pictures.png"),
                "--fields", ",".join(pictures["fields"]),
                "--exaggerate", str(pictures["exaggerate"]),
-               "--view", *[str(v) for v in pictures["view"]], "--titles", *pictures["titles"]]
+               "--view", *[str(v) for v in pictures["view"]], "--up", pictures["up"],
+               "--titles", *pictures["titles"]]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         print(f"experiment: rendering failed: {result.stderr.strip()[-300:]}", file=sys.stderr)
+    if pictures.get("gif"):
+        series = [f for f in os.listdir(folder) if f.endswith(".pvd")]
+        if not series:
+            print("experiment: the picture run wrote no .pvd series", file=sys.stderr)
+            return
+        command = [sys.executable, os.path.join(HERE, "render.py"),
+                   os.path.join(folder, series[0]),
+                   "--gif", os.path.join(args.out, spec["name"], "animation.gif"),
+                   "--fields", pictures["gif"], "--exaggerate", str(pictures["exaggerate"]),
+                   "--view", *[str(v) for v in pictures["view"]], "--up", pictures["up"]]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            print(f"experiment: the animation failed: {result.stderr.strip()[-300:]}",
+                  file=sys.stderr)
 
 
 def error_against(reference, frames):

@@ -2,8 +2,9 @@
 """Pictures of strata frames: the deformed body's surface coloured by a per-cell field.
 
   render.py FRAME.vtu [FRAME.vtu ...] --out PICTURE.png [--fields level,von_mises,...]
-            [--view ELEVATION AZIMUTH] [--titles "peak load" "unloaded" ...] [--exaggerate K]
-  render.py SERIES.pvd --gif ANIMATION.gif [--fields level] [--fps 8]
+            [--view ELEVATION AZIMUTH] [--up x|y|z] [--titles "peak load" "unloaded" ...]
+            [--exaggerate K]
+  render.py SERIES.pvd --gif ANIMATION.gif [--fields level] [--fps 8] [--up x|y|z]
 
 One panel per frame and field (rows: frames, columns: fields). A frame is a .vtu that `strata
 run` writes (positions already deformed); its boundary triangles (the tet faces that belong to
@@ -12,6 +13,7 @@ bar per field shared by the frames. The surface .vtp frames of a bound fine surf
 the same way (point fields are averaged per triangle). Fields: any cell field of the frame —
 `level` (active tree level, integer colours), `von_mises` [Pa], `plastic_strain`, `stress` or
 `green_strain` (the first Voigt component) — or a point field (`displacement` magnitude).
+`--up` names the model's vertical axis (default z; y for models such as the armadillo scan).
 Needs /usr/bin/python3 (matplotlib, meshio, numpy; Pillow for --gif).
 """
 import argparse
@@ -83,8 +85,14 @@ def positions(mesh, exaggerate):
     return points
 
 
-def draw(axis, points, faces, colours, elevation, azimuth):
+# Column order that puts the model's up axis on the plot's vertical axis (a cyclic permutation:
+# the picture is not mirrored).
+UP = {"x": [1, 2, 0], "y": [2, 0, 1], "z": [0, 1, 2]}
+
+
+def draw(axis, points, faces, colours, elevation, azimuth, up="z"):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    points = points[:, UP[up]]
     polygons = points[faces]
     axis.add_collection3d(Poly3DCollection(polygons, facecolors=colours, edgecolors=(0, 0, 0, 0.15),
                                            linewidths=0.2))
@@ -97,7 +105,7 @@ def draw(axis, points, faces, colours, elevation, azimuth):
     axis.set_axis_off()
 
 
-def render(frames, fields, out, titles, view, exaggerate):
+def render(frames, fields, out, titles, view, exaggerate, up="z"):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -118,7 +126,7 @@ def render(frames, fields, out, titles, view, exaggerate):
         for row, (mesh, (faces, _), v) in enumerate(zip(meshes, surfaces, per_frame)):
             axis = figure.add_subplot(len(frames), len(fields), row * len(fields) + column + 1,
                                       projection="3d")
-            draw(axis, positions(mesh, exaggerate), faces, cmap(norm(v)), *view)
+            draw(axis, positions(mesh, exaggerate), faces, cmap(norm(v)), *view, up)
             title = LABELS.get(field, field)
             if titles:
                 title = f"{titles[row]}: {title}"
@@ -149,7 +157,7 @@ def series(pvd):
     return [(t, os.path.join(folder, f)) for t, f in sorted(entries)]
 
 
-def animate(pvd, field, out, fps, view, exaggerate):
+def animate(pvd, field, out, fps, view, exaggerate, up="z"):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -170,7 +178,7 @@ def animate(pvd, field, out, fps, view, exaggerate):
     def frame(i):
         axis.clear()
         draw(axis, positions(meshes[i], exaggerate), surfaces[i][0], cmap(norm(per_frame[i])),
-             *view)
+             *view, up)
         axis.set_title(f"{LABELS.get(field, field)}, t = {frames[i][0]:.4g}", fontsize=9)
 
     animation = FuncAnimation(figure, frame, frames=len(frames))
@@ -190,6 +198,8 @@ def main():
     parser.add_argument("--view", nargs=2, type=float, default=(22.0, -60.0),
                         metavar=("ELEVATION", "AZIMUTH"))
     parser.add_argument("--fps", type=int, default=8)
+    parser.add_argument("--up", choices=sorted(UP), default="z",
+                        help="the model's vertical axis (default z)")
     parser.add_argument("--exaggerate", type=float, default=1.0,
                         help="scale the displacement by this factor (1: as simulated)")
     args = parser.parse_args()
@@ -200,14 +210,15 @@ def main():
     if args.gif:
         if len(args.inputs) != 1 or not args.inputs[0].endswith(".pvd"):
             fail("--gif takes one .pvd series")
-        animate(args.inputs[0], fields[0], args.gif, args.fps, args.view, args.exaggerate)
+        animate(args.inputs[0], fields[0], args.gif, args.fps, args.view, args.exaggerate,
+                args.up)
         print(f"render: wrote {args.gif}")
         return
     if not args.out:
         fail("--out PICTURE.png (or --gif) is required")
     if args.titles and len(args.titles) != len(args.inputs):
         fail(f"--titles: {len(args.titles)} titles for {len(args.inputs)} frames")
-    render(args.inputs, fields, args.out, args.titles, args.view, args.exaggerate)
+    render(args.inputs, fields, args.out, args.titles, args.view, args.exaggerate, args.up)
     print(f"render: wrote {args.out}")
 
 

@@ -192,7 +192,8 @@ def main():
         target = os.path.join(args.out, name)
         os.makedirs(target, exist_ok=True)
         charts = []
-        for chart in ("error_vs_cost.png", "adaptive_over_time.png", "pictures.png"):
+        for chart in ("error_vs_cost.png", "adaptive_over_time.png", "pictures.png",
+                      "animation.gif"):
             source = os.path.join(args.results, name, chart)
             if os.path.exists(source):
                 shutil.copyfile(source, os.path.join(target, chart))

@@ -125,14 +125,16 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
                                        const std::vector<RegionLoad>& loads,
                                        std::optional<GroundPlane> ground, const Vector3d& gravity,
                                        const SolverSettings& settings,
-                                       std::vector<Obstacle> obstacles)
+                                       std::vector<Obstacle> obstacles,
+                                       std::vector<RootPoint> contact_surface)
     : m_settings(hierarchy),
       m_material(material),
       m_dirichlet(std::move(dirichlet)),
       m_ground(std::move(ground)),
       m_gravity(gravity),
       m_solver(settings),
-      m_obstacles(std::move(obstacles)) {
+      m_obstacles(std::move(obstacles)),
+      m_contact_surface(std::move(contact_surface)) {
   validate_hierarchy_settings(m_settings, "hierarchy");
   validate_material(m_material, "material");
   validate_solver_settings(m_solver, "solver");
@@ -142,6 +144,13 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   const auto start = Clock::now();
   m_tree = std::make_unique<TetTree>(coarse, m_settings.levels);
   m_tolerance = region_tolerance(coarse.vertices);
+  if (!m_obstacles.empty())
+    m_contact_stiffness = m_material.youngs_modulus *
+                          mean_edge_length(coarse.vertices, coarse.tets) /
+                          std::pow(2.0, m_settings.levels);
+  for (const RootPoint& point : m_contact_surface)
+    if (point.root < 0 || point.root >= m_tree->num_roots() || !point.position.allFinite())
+      throw InputError("contact surface: a point needs a root tet and a finite position");
   const int start_level =
       m_settings.mode == HierarchyMode::full ? m_settings.levels : m_settings.level;
   if (m_settings.mode == HierarchyMode::precomputed) {
@@ -168,7 +177,8 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   // Keep Dirichlet groups exact: never merge children into a parent on which one would not be
   // (vetoed before the controller spends its element budget).
   m_controller->set_coarsening_veto([this](NodeId parent) {
-    return dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
+    return !m_in_contact.contains(parent) &&
+           dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
   });
   std::vector<RegionLoad> constant_loads;
   for (const RegionLoad& load : loads) {
@@ -214,7 +224,7 @@ void AdaptiveSimulation::initial_adaptation() {
     options.extra_mesh_forces =
         m_mesh_external - gravity_forces(m_simulation->vertex_mass(), m_gravity);
     options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
-    options.obstacles = m_obstacles;
+    add_contact(options);
     std::unique_ptr<Simulation> solve;
     try {
       solve = std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet,
@@ -225,9 +235,9 @@ void AdaptiveSimulation::initial_adaptation() {
       break;
     }
     const TetFields fields = solve->model().tet_fields(solve->positions());
-    CutState state{
-        *m_tree,    flat, solve->positions(), fields, m_mesh_external, solve->vertex_mass(),
-        m_material, 0,    &m_load_traction};
+    const VectorXd loads = criteria_loads(*solve);
+    CutState state{*m_tree,    flat, solve->positions(), fields, loads, solve->vertex_mass(),
+                   m_material, 0,    &m_load_traction};
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
     if (m_settings.indicator == "recovery" && estimate.relative_error <= m_settings.tolerance)
@@ -334,7 +344,7 @@ void AdaptiveSimulation::rebuild(long first_step) {
   options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads, &m_load_traction);
   options.first_step = first_step;
   options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
-  options.obstacles = m_obstacles;
+  add_contact(options);
   m_mesh_external = options.extra_mesh_forces;
   // The criteria see every load at its peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads) {
@@ -369,18 +379,18 @@ void AdaptiveSimulation::advance() {
   m_estimate_valid = false;
   m_simulation->advance();
   m_stepping_seconds += seconds_since(start);
-  if (m_settings.mode == HierarchyMode::adaptive) {
-    if (is_static(m_solver)) {
-      // Solve–mark–refine: re-solve the same load factor on each new cut.
-      for (int pass = 0; pass < m_settings.max_passes && adapt(pass, true, true); ++pass) {
-        const auto solve_start = Clock::now();
-        m_simulation->resolve_static();
-        m_stepping_seconds += seconds_since(solve_start);
-      }
-    } else if (step_count() % m_settings.adapt_every == 0 && !finished()) {
-      adapt(0, true, true);
+  if (m_settings.mode == HierarchyMode::adaptive && is_static(m_solver)) {
+    // Solve–mark–refine: re-solve the same load factor on each new cut.
+    for (int pass = 0; pass < m_settings.max_passes && adapt(pass, true, true); ++pass) {
+      const auto solve_start = Clock::now();
+      m_simulation->resolve_static();
+      m_stepping_seconds += seconds_since(solve_start);
     }
   }
+  record_contact_step();
+  if (m_settings.mode == HierarchyMode::adaptive && !is_static(m_solver) &&
+      step_count() % m_settings.adapt_every == 0 && !finished())
+    adapt(0, true, true);
   record_sample();
 }
 
@@ -415,14 +425,44 @@ void AdaptiveSimulation::advance_with_redo() {
     attempt = seconds_since(step_start);
     m_stepping_seconds += attempt;
   }
+  record_contact_step();
   if (step_count() % m_settings.adapt_every == 0 && !finished()) adapt(0, false, true);
+}
+
+void AdaptiveSimulation::add_contact(SimulationOptions& options) const {
+  if (m_obstacles.empty()) return;
+  options.obstacles = m_obstacles;
+  options.contact_stiffness = m_contact_stiffness;
+  options.contact_points.clear();
+  options.contact_points.reserve(m_contact_surface.size());
+  for (const CutPointWeights& w : embed_points(*m_cut, m_constrained->flat, m_contact_surface))
+    options.contact_points.push_back({{w.vertices[0], w.vertices[1], w.vertices[2], w.vertices[3]},
+                                      {w.weights[0], w.weights[1], w.weights[2], w.weights[3]}});
+}
+
+VectorXd AdaptiveSimulation::criteria_loads(const Simulation& simulation) {
+  m_in_contact.clear();
+  if (!simulation.has_obstacles()) return m_mesh_external;
+  const VectorXd contact = simulation.mesh_contact_forces();
+  const FlatTreeMesh& flat = m_constrained->flat;
+  for (Index t = 0; t < flat.mesh.tets.rows(); ++t) {
+    bool touched = false;
+    for (int k = 0; k < 4 && !touched; ++k)
+      touched = !contact.segment<3>(3 * flat.mesh.tets(t, k)).isZero();
+    if (!touched) continue;
+    for (NodeId n = flat.tet_nodes[t]; n != kNoNode && m_in_contact.insert(n).second;
+         n = m_tree->parent(n)) {
+    }
+  }
+  return m_mesh_external + contact;
 }
 
 CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
   const TetFields fields = sim.model().tet_fields(sim.positions());
-  CutState state{*m_tree,           flat,       sim.positions(),  fields,          m_mesh_external,
+  const VectorXd loads = criteria_loads(sim);
+  CutState state{*m_tree,           flat,       sim.positions(),  fields,          loads,
                  sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
   state.solution_energy_scale = m_energy_scale;
   m_estimate = recovery_error_estimate(state);
@@ -496,6 +536,7 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
     keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_simulation->dof_vertex_mass(),
                         old_kinetic_energy, old_momentum);
+    if (!m_obstacles.empty()) record.contact_correction = m_simulation->push_out_of_obstacles();
   } catch (...) {
     m_constrained = std::move(old_cut);
     m_simulation = std::move(old_simulation);
@@ -599,6 +640,12 @@ void AdaptiveSimulation::keep_kinetic_energy(const FlatTreeMesh& old_flat,
     v.segment<3>(3 * q) = shifted_mean + scale * (v.segment<3>(3 * q) - region_mean);
   const VectorXd q = m_simulation->dof_positions();
   m_simulation->set_state(q, v);
+}
+
+void AdaptiveSimulation::record_contact_step() {
+  if (!m_simulation->has_obstacles() || m_simulation->contact_counts().empty()) return;
+  m_contact_counts.push_back(m_simulation->contact_counts().back());
+  m_max_penetration = std::max(m_max_penetration, m_simulation->last_penetration());
 }
 
 void AdaptiveSimulation::record_sample() {

@@ -136,15 +136,21 @@ CutChanges RefinementController::decide(const CutState& state, const ActiveCut& 
       if (mergeable) mean += state.fields.cauchy_stress.row(child_tet).transpose() / 8.0;
     }
     if (!mergeable) continue;
+    // The children's stresses agree, or the indicator says the merged parent stays below the
+    // coarsening bound.
+    std::array<int, 8> children{};
+    for (int k = 0; k < 8; ++k)
+      children[k] = node_tet[tree.child(parent, k)];
     const double limit = m_settings.coarsen_tolerance * (voigt_frobenius_norm(mean) + floor);
     for (int k = 0; k < 8 && mergeable; ++k) {
-      const int child_tet = node_tet[tree.child(parent, k)];
-      const Vector6d diff = state.fields.cauchy_stress.row(child_tet).transpose() - mean;
+      const Vector6d diff = state.fields.cauchy_stress.row(children[k]).transpose() - mean;
       mergeable = voigt_frobenius_norm(diff) < limit;
-      if (mergeable && m_settings.balance)
-        for (int i = 0; i < 4 && mergeable; ++i)
-          mergeable = finest[flat.mesh.tets(child_tet, i)] <= tree.level(parent) + 1;
     }
+    if (!mergeable)
+      mergeable = m_indicator->merge_indicator(state, children, tree.level(parent)) < coarsen_bound;
+    for (int k = 0; k < 8 && mergeable && m_settings.balance; ++k)
+      for (int i = 0; i < 4 && mergeable; ++i)
+        mergeable = finest[flat.mesh.tets(children[k], i)] <= tree.level(parent) + 1;
     if (mergeable) changes.coarsen.push_back(parent);
   }
   std::sort(changes.coarsen.begin(), changes.coarsen.end());

@@ -1,8 +1,14 @@
 #include "strata/hierarchy/refinement_indicator.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace strata {
+
+double RefinementIndicator::merge_indicator(const CutState&, const std::array<int, 8>&,
+                                            int) const {
+  return std::numeric_limits<double>::infinity();
+}
 
 double voigt_frobenius_norm(const Vector6d& voigt) {
   return std::sqrt(voigt.head<3>().squaredNorm() + 2.0 * voigt.tail<3>().squaredNorm());

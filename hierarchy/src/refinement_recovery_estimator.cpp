@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
 
 namespace strata {
 
@@ -85,6 +86,41 @@ void RecoveryIndicator::evaluate(const CutState& state, VectorXd& eta) const {
   const double energy_tolerance = m_tolerance / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   eta = (estimate.element_error_sq / share).cwiseSqrt();
+}
+
+double RecoveryIndicator::merge_indicator(const CutState& state,
+                                          const std::array<int, 8>& children,
+                                          int parent_level) const {
+  RecoveryEstimate computed;
+  if (state.recovery_estimate == nullptr) computed = recovery_error_estimate(state);
+  const RecoveryEstimate& estimate =
+      state.recovery_estimate != nullptr ? *state.recovery_estimate : computed;
+  const Index n = estimate.element_error_sq.size();
+  if (estimate.reference_energy_sq <= 0.0 || n == 0) return 0.0;
+  const TetMesh& mesh = state.flat.mesh;
+  const auto& strain = state.fields.green_strain;
+  std::array<double, 8> volume{};
+  Vector6d mean = Vector6d::Zero();
+  double total = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const auto corner = [&](int i) {
+      return Vector3d(mesh.vertices.row(mesh.tets(children[k], i)).transpose());
+    };
+    volume[k] = std::abs(tet_signed_volume(corner(0), corner(1), corner(2), corner(3)));
+    mean += volume[k] * strain.row(children[k]).transpose();
+    total += volume[k];
+  }
+  mean /= total;
+  const LameParameters lame = state.material.lame();
+  double loss = 0.0;
+  for (int k = 0; k < 8; ++k)
+    loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
+  const int depth = state.tree.max_level();
+  const double removed =
+      (1.0 - std::pow(2.0, -(depth - parent_level))) * std::pow(2.0, -0.5 * parent_level);
+  const double energy_tolerance = m_tolerance / kDisplacementPerEnergyError;
+  const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
+  return std::sqrt(loss * removed * removed / share);
 }
 
 }  // namespace strata

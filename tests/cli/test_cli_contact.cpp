@@ -1,6 +1,8 @@
 // End-to-end: obstacles from the scene file — a block dropped on an implicit sphere (a level set)
-// stays within the contact tolerance and reports its contacts; a block
-// pressed onto a plane obstacle carries the load; bad obstacle keys name their path.
+// stays within the contact tolerance and reports its contacts, also on an adaptive cut, where it
+// follows the full-resolution run; a block pressed onto a plane obstacle carries the load; the
+// fine surface collides; `ground` is a plane obstacle with static friction; bad obstacle keys
+// name their path.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -130,12 +132,94 @@ TEST(CliContact, BadObstaclesNameTheirKey) {
   result = run_strata("run inside.json --quiet", folder.path());
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.err, HasSubstr("obstacles.0: contact point"));
-  scene = drop_scene();
-  scene["hierarchy"] = {{"levels", 1}};
-  write_text(folder.path() / "tree.json", scene.dump(2));
-  result = run_strata("run tree.json --quiet", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("obstacles: not supported with hierarchy yet"));
+}
+
+TEST(CliContact, AdaptiveDropOnASphereFollowsFullResolution) {
+  // The drop on the hierarchy: the adaptive run (levels 1, τ = 0.01) stays within the contact
+  // tolerance, refines near the contact, and its probe follows the full-resolution run's.
+  TempFolder folder;
+  for (const char* mode : {"full", "adaptive"}) {
+    json scene = drop_scene();
+    scene["solver"]["duration"] = 0.25;
+    scene["output"]["every"] = 10;
+    scene["hierarchy"] = {{"levels", 1}, {"mode", mode}};
+    write_text(folder.path() / (std::string(mode) + ".json"), scene.dump(2));
+    const CliResult result = run_strata(std::string("run ") + mode + ".json --quiet", folder.path());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+  }
+  const json full = read_json(folder.path() / "out" / "full" / "stats.json");
+  const json adaptive = read_json(folder.path() / "out" / "adaptive" / "stats.json");
+  for (const json* stats : {&full, &adaptive}) {
+    ASSERT_TRUE(stats->contains("contact"));
+    EXPECT_GT((*stats)["contact"]["max_penetration"].get<double>(), 0.0);  // it landed
+    EXPECT_LE((*stats)["contact"]["max_penetration"].get<double>(),
+              (*stats)["contact"]["tolerance"].get<double>());
+    EXPECT_EQ((*stats)["contact"]["active_contacts"].size(), 250u);
+  }
+  EXPECT_EQ(full["contact"]["barrier_stiffness"], adaptive["contact"]["barrier_stiffness"]);
+  EXPECT_GT(adaptive["hierarchy"]["refinements"].get<int>(), 0);
+  const Csv a = read_csv(folder.path() / "out" / "adaptive" / "probes.csv");
+  const Csv f = read_csv(folder.path() / "out" / "full" / "probes.csv");
+  ASSERT_EQ(a.rows.size(), f.rows.size());
+  double largest = 0.0, difference = 0.0;
+  for (size_t r = 0; r < f.rows.size(); ++r) {
+    const Vector3d uf(f.rows[r][5], f.rows[r][6], f.rows[r][7]);
+    const Vector3d ua(a.rows[r][5], a.rows[r][6], a.rows[r][7]);
+    largest = std::max(largest, uf.norm());
+    difference = std::max(difference, (ua - uf).norm());
+  }
+  EXPECT_GT(largest, 0.01);  // it fell about 2 cm
+  EXPECT_LT(difference, 0.02 * largest);
+}
+
+TEST(CliContact, GroundIsAPlaneObstacleThatHoldsStaticFriction) {
+  // `ground` is the plane obstacle: a cube on it with μ = 0.5 (friction angle 26.6°) under gravity
+  // tilted by 15° stays put (drift below the contact tolerance, as on an `obstacles` plane);
+  // tilted by 35° it slides with g (sin θ − μ cos θ) within 2 %.
+  TempFolder folder;
+  for (const double degrees : {15.0, 35.0}) {
+    const double theta = degrees * M_PI / 180.0;
+    json scene = json::parse(R"({
+      "mesh": {"box": {"min": [-0.05, -0.05, 0], "max": [0.05, 0.05, 0.1], "cells": [1, 1, 1]}},
+      "material": {"model": "neohookean", "youngs_modulus": 1e6, "poisson_ratio": 0.3,
+                   "density": 1000},
+      "ground": {"point": [0, 0, 0], "normal": [0, 0, 1], "friction": 0.5},
+      "solver": {"mode": "dynamic", "dt": 0.001, "duration": 0.35},
+      "output": {"vtk": false, "probes": [[0, 0, 0.05]]}
+    })");
+    scene["gravity"] = {9.81 * std::sin(theta), 0.0, -9.81 * std::cos(theta)};
+    const std::string name = "tilt" + std::to_string(static_cast<int>(degrees));
+    write_text(folder.path() / (name + ".json"), scene.dump(2));
+    const CliResult result = run_strata("run " + name + ".json --quiet", folder.path());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const json stats = read_json(folder.path() / "out" / name / "stats.json");
+    ASSERT_TRUE(stats.contains("contact"));
+    const double tolerance = stats["contact"]["tolerance"];
+    EXPECT_LE(stats["contact"]["max_penetration"].get<double>(), tolerance);
+    const Csv probes = read_csv(folder.path() / "out" / name / "probes.csv");
+    // Columns: time, probe, x, y, z, ux, uy, uz (centre of the cube).
+    double drift = 0.0, v1 = 0.0, t1 = 0.0, u_prev = 0.0, t_prev = 0.0;
+    for (const auto& row : probes.rows) {
+      drift = std::max(drift, std::abs(row[5]));
+      const double v = row[0] > t_prev ? (row[5] - u_prev) / (row[0] - t_prev) : 0.0;
+      if (std::abs(row[0] - 0.15) < 1e-9) {
+        v1 = v;
+        t1 = row[0];
+      }
+      u_prev = row[5];
+      t_prev = row[0];
+    }
+    if (degrees < 26.0) {
+      EXPECT_LT(drift, tolerance) << degrees;
+    } else {
+      const auto& last = probes.rows.back();
+      const auto& before = probes.rows[probes.rows.size() - 2];
+      const double v_end = (last[5] - before[5]) / (last[0] - before[0]);
+      const double a = (v_end - v1) / (t_prev - t1);
+      const double expected = 9.81 * (std::sin(theta) - 0.5 * std::cos(theta));
+      EXPECT_NEAR(a, expected, 0.02 * expected);
+    }
+  }
 }
 
 }  // namespace

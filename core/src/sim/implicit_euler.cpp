@@ -52,6 +52,8 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
     if (!std::isfinite(m_contact->value(y))) {
       y = x_start;
       sys.apply_constraints(t + h, y, v_end);
+      // An obstacle that moved into the body within the step: lift the start out of it.
+      if (!std::isfinite(m_contact->value(y))) m_contact->push_out(y, sys.constrained, 0.5);
     }
   }
 

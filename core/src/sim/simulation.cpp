@@ -141,9 +141,14 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     }
     m_extra_contact_points = static_cast<Index>(options.contact_points.size());
     m_contact_points = embed_points(mesh_points);
+    m_mesh_contact_points = std::move(mesh_points);
     contact.distance =
         m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * m_diagonal;
-    contact.stiffness = m_material.youngs_modulus * m_embedded->mean_edge_length();
+    if (!(options.contact_stiffness >= 0.0) || !std::isfinite(options.contact_stiffness))
+      throw InputError("simulation: contact_stiffness must be finite and >= 0");
+    contact.stiffness = options.contact_stiffness > 0.0
+                            ? options.contact_stiffness
+                            : m_material.youngs_modulus * m_embedded->mean_edge_length();
     contact.friction_slip =
         m_settings.friction_slip > 0.0 ? m_settings.friction_slip : 1e-3 * contact.distance;
     m_contact = std::make_unique<ContactTerm>(m_obstacles, m_contact_points, contact);
@@ -176,7 +181,9 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     m_system->apply_constraints(time(), m_x, m_v);
   }
   update_mesh_state();
-  if (m_contact) {
+  // A run that continues from an earlier step (first_step > 0) takes its state from set_state:
+  // its rest state need not be feasible at the current time.
+  if (m_contact && m_first_step == 0) {
     const double t = is_static() ? 0.0 : time();
     m_contact->set_step(m_x, t, t);
     for (const Obstacle& obstacle : m_obstacles)
@@ -266,6 +273,7 @@ void Simulation::advance() {
   if (has_obstacles()) record_contact(q_start, is_static() ? 0.0 : t0, is_static() ? 0.0 : t1);
   if (m_springs) m_springs->yield(m_x);
   ++m_steps;
+  if (has_obstacles()) m_contact_step = m_steps;
   check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
                    m_steps, time(), std::string(m_stepper_traits->name));
 }
@@ -298,9 +306,32 @@ std::vector<ContactPoint> Simulation::embed_points(const std::vector<ContactPoin
 
 void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {
   m_contact->set_step(q_start, t0, t1);
-  m_max_penetration = std::max(m_max_penetration, -m_contact->min_distance(m_x));
+  m_last_penetration = -m_contact->min_distance(m_x);
+  m_max_penetration = std::max(m_max_penetration, m_last_penetration);
   VectorXd unused = VectorXd::Zero(m_x.size());
   m_contact_counts.push_back(m_contact->add_normal_forces(m_x, unused));
+}
+
+VectorXd Simulation::mesh_contact_forces() const {
+  VectorXd f = VectorXd::Zero(3 * m_mesh.vertices.rows());
+  if (!m_contact) return f;
+  const std::vector<Vector3d> point_forces = m_contact->normal_point_forces(m_x);
+  for (size_t p = 0; p < point_forces.size(); ++p) {
+    if (point_forces[p].isZero()) continue;
+    const ContactPoint& point = m_mesh_contact_points[p];
+    for (size_t k = 0; k < point.vertices.size(); ++k)
+      f.segment<3>(3 * point.vertices[k]) += point.weights[k] * point_forces[p];
+  }
+  return f;
+}
+
+double Simulation::push_out_of_obstacles(double depth) {
+  if (!m_contact) return 0.0;
+  const double t = is_static() ? 0.0 : time();
+  m_contact->set_step(m_x, t, t);
+  const double largest = m_contact->push_out(m_x, m_constrained, depth);
+  if (largest > 0.0) update_mesh_state();
+  return largest;
 }
 
 VectorXd Simulation::contact_forces() const {
@@ -436,6 +467,14 @@ void Simulation::resolve_static() {
   update_mesh_state();
   // Plastic flow from the carried state, with further passes until it settles.
   if (is_plastic()) update_plastic_state(lambda, lambda, 0.0, m_x, m_v);
+  if (has_obstacles()) {
+    // The re-solved state replaces this load step's contact record (a rebuilt Simulation has
+    // none yet).
+    const VectorXd q_start = m_x;
+    if (m_contact_step == m_steps && !m_contact_counts.empty()) m_contact_counts.pop_back();
+    record_contact(q_start, 0.0, 0.0);
+    m_contact_step = m_steps;
+  }
   check_divergence(*m_model, positions(), VectorXd(), m_limits, m_steps, lambda, "static");
 }
 

@@ -428,12 +428,6 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     for (const SceneValue& entry : top.at("obstacles").elements()) {
       scene.obstacles.push_back(parse_obstacle(entry, file.parent_path()));
     }
-    if (top.has("hierarchy") && !scene.obstacles.empty()) {
-      throw SceneKeyError(file_name, "obstacles",
-                          "not supported with hierarchy yet (cut changes near contact can stall "
-                          "Newton)",
-                          false);
-    }
   }
   scene.solver = parse_solver(top.at("solver"));
   if (top.has("output")) scene.output = parse_output(top.at("output"));

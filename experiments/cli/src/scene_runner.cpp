@@ -44,10 +44,15 @@ long planned_steps(const SolverSettings& settings) {
   return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
 }
 
-/// The scene's obstacles: planes in closed form, the others as level sets (implicit shapes and
-/// surfaces voxelised at `voxel_size`, default half the mesh's mean edge length).
+/// The scene's obstacles: `ground` first (a plane obstacle named "ground"), then `obstacles`:
+/// planes in closed form, the others as level sets (implicit shapes and surfaces voxelised at
+/// `voxel_size`, default half the mesh's mean edge length).
 std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
   std::vector<Obstacle> obstacles;
+  if (scene.ground) {
+    obstacles.push_back(plane_obstacle("ground", scene.ground->point, scene.ground->normal));
+    obstacles.back().friction = scene.ground->friction;
+  }
   const double mean_edge = mean_edge_length(mesh.vertices, mesh.tets);
   for (const ObstacleSpec& spec : scene.obstacles) {
     Obstacle obstacle;
@@ -81,18 +86,28 @@ class SceneSimulation {
  public:
   /// Core InputErrors get the scene file as prefix.
   /// `binding`: the fine surface bound to `mesh` (it collides with the obstacles); may be null.
-  SceneSimulation(const Scene& scene, const TetMesh& mesh, const SurfaceBinding* binding) {
+  /// `surface_rest`: its rest vertices (with `binding`).
+  SceneSimulation(const Scene& scene, const TetMesh& mesh, const SurfaceBinding* binding,
+                  const MatrixX3d* surface_rest) {
     try {
+      std::vector<Obstacle> obstacles = build_obstacles(scene, mesh);
       if (scene.hierarchy) {
+        // The fine surface's vertices as material points of the tree (bound to the coarse mesh,
+        // the tree's roots): each cut embeds them in its active tets.
+        std::vector<RootPoint> contact_surface;
+        if (!obstacles.empty() && binding != nullptr)
+          for (Index i = 0; i < binding->tets.size(); ++i)
+            contact_surface.push_back({binding->tets[i], surface_rest->row(i).transpose()});
         auto adaptive = std::make_unique<AdaptiveSimulation>(
             mesh, *scene.hierarchy, scene.material, scene.dirichlet_groups(), scene.forces,
-            scene.ground, scene.gravity, scene.solver, build_obstacles(scene, mesh));
+            std::nullopt, scene.gravity, scene.solver, std::move(obstacles),
+            std::move(contact_surface));
         m_adaptive = adaptive.get();
         m_run = std::move(adaptive);
       } else {
         SimulationOptions options;
         options.surface_springs = scene.surface_springs;
-        options.obstacles = build_obstacles(scene, mesh);
+        options.obstacles = std::move(obstacles);
         if (!options.obstacles.empty() && binding != nullptr) {
           // The fine surface collides too: its vertices are contact points through their binding.
           for (Index i = 0; i < binding->corners.rows(); ++i)
@@ -103,7 +118,7 @@ class SceneSimulation {
                   binding->barycentric(i, 2), binding->barycentric(i, 3)}});
         }
         m_run = std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
-                                             scene.forces, scene.ground, scene.gravity,
+                                             scene.forces, std::nullopt, scene.gravity,
                                              scene.solver, std::move(options));
       }
     } catch (const InputError& error) {
@@ -173,7 +188,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
                        {"energy_before", change.energy_before},
                        {"energy_after", change.energy_after},
                        {"seconds", change.seconds},
-                       {"plastic_merge_change", change.plastic_merge_change}});
+                       {"plastic_merge_change", change.plastic_merge_change},
+                       {"contact_correction", change.contact_correction}});
   }
   block["refinements"] = refinements;
   block["coarsenings"] = coarsenings;
@@ -267,13 +283,16 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   }
   if (simulation.has_obstacles()) {
     const ContactSettings& contact = simulation.contact_settings();
-    stats["contact"] = {{"max_penetration", simulation.max_penetration()},
+    const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
+    stats["contact"] = {{"max_penetration", adaptive ? adaptive->max_penetration()
+                                                     : simulation.max_penetration()},
                         {"tolerance", contact.distance},
                         {"barrier_stiffness", contact.stiffness},
                         {"friction_slip", contact.friction_slip},
                         {"points", simulation.contact_points()},
                         {"surface_points", simulation.extra_contact_points()},
-                        {"active_contacts", simulation.contact_counts()}};
+                        {"active_contacts", adaptive ? adaptive->contact_counts()
+                                                     : simulation.contact_counts()}};
   }
   if (scene.material.plasticity) {
     const Plasticity& plasticity = *scene.material.plasticity;
@@ -353,9 +372,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   // The fine surface, bound once to the simulation mesh: rendered with the frames and, with
   // obstacles, tested for contact.
   std::optional<FineSurface> surface;
-  if (scene.mesh.surface && (scene.output.vtk || !scene.obstacles.empty()))
+  const bool has_contact = scene.ground || !scene.obstacles.empty();
+  if (scene.mesh.surface && (scene.output.vtk || has_contact))
     surface.emplace(read_surface(*scene.mesh.surface), prepared.mesh);
-  SceneSimulation scene_simulation(scene, prepared.mesh, surface ? &surface->binding() : nullptr);
+  SceneSimulation scene_simulation(scene, prepared.mesh, surface ? &surface->binding() : nullptr,
+                                   surface ? &surface->rest().vertices : nullptr);
   const Simulation* simulation = &scene_simulation.current();
   summary.stable_dt_estimate = simulation->stable_dt_estimate();
   std::vector<RootPoint> probe_roots;

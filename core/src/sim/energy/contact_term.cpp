@@ -211,6 +211,51 @@ Index ContactTerm::add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const {
   return active;
 }
 
+double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained,
+                             double depth) const {
+  const double limit = depth * m_settings.distance;
+  VectorXd moved = VectorXd::Zero(q.size());
+  for (int pass = 0; pass < 20; ++pass) {
+    VectorXd correction = VectorXd::Zero(q.size());
+    bool inside = false;
+    for (const Obstacle& obstacle : m_obstacles)
+      for (Index p = 0; p < num_points(); ++p) {
+        Vector3d n;
+        const double phi = obstacle.distance_at(position(q, p), m_time, n);
+        if (!(phi < -limit)) continue;
+        inside = true;
+        const ContactPoint& point = m_points[p];
+        double weight_sq = 0.0;
+        for (size_t k = 0; k < point.vertices.size(); ++k)
+          if (!constrained[3 * point.vertices[k]]) weight_sq += point.weights[k] * point.weights[k];
+        if (weight_sq == 0.0) continue;
+        const Vector3d lift = -phi * n.normalized() / weight_sq;
+        for (size_t k = 0; k < point.vertices.size(); ++k)
+          for (int c = 0; c < 3; ++c)
+            if (!constrained[3 * point.vertices[k] + c])
+              correction[3 * point.vertices[k] + c] += point.weights[k] * lift[c];
+      }
+    if (!inside) break;
+    q += correction;
+    moved += correction;
+  }
+  double largest = 0.0;
+  for (Index v = 0; v < moved.size() / 3; ++v)
+    largest = std::max(largest, moved.segment<3>(3 * v).norm());
+  return largest;
+}
+
+std::vector<Vector3d> ContactTerm::normal_point_forces(ConstRef<VectorXd> q) const {
+  std::vector<Vector3d> forces(m_points.size(), Vector3d::Zero());
+  for (const Obstacle& obstacle : m_obstacles)
+    for (Index p = 0; p < num_points(); ++p) {
+      Vector3d n;
+      const double d = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
+      if (d > 0.0 && d < m_settings.distance) forces[p] -= barrier_derivative(d) * n;
+    }
+  return forces;
+}
+
 double ContactTerm::min_distance(ConstRef<VectorXd> q) const {
   double smallest = std::numeric_limits<double>::infinity();
   for (const Obstacle& obstacle : m_obstacles)

@@ -44,6 +44,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "strata/core/sim/simulation.hpp"
@@ -113,6 +114,9 @@ struct CutChangeRecord {
   /// Plastic materials: largest |ε̄ₚ(child) − ε̄ₚ(parent)| over the merges of this change (the
   /// detail a merge averages away; 0 without merges or plasticity).
   double plastic_merge_change = 0.0;
+  /// Obstacles: the largest move of a DOF vertex that took the transferred state out of the
+  /// obstacles (AdaptiveSimulation, "Contact") [m]; 0 when it was feasible.
+  double contact_correction = 0.0;
 };
 
 /// The active cut after a step.
@@ -147,15 +151,22 @@ class AdaptiveSimulation final : public SimulationRun {
  public:
   /// `coarse`: the roots (validated and oriented by the caller, as for Simulation). The region
   /// loads are applied on the finest level; gravity, Dirichlet groups, ground and solver settings
-  /// as in Simulation; `obstacles` (SimulationOptions::obstacles) are contacted by every active
-  /// cut's boundary vertices, hanging ones included (cut changes near a curved obstacle can stall
-  /// Newton: the CLI does not offer obstacles with a hierarchy yet). Throws InputError for
-  /// invalid settings or scene data.
+  /// as in Simulation. Contact: `obstacles` (SimulationOptions::obstacles) are contacted by every
+  /// active cut's boundary vertices, hanging ones included, and by the material points
+  /// `contact_surface` (e.g. a fine surface's vertices, located in their roots), embedded in each
+  /// cut's active tets — so fine detail collides even on a coarse cut. The barrier stiffness is
+  /// the same on every cut: E × the coarse mesh's mean edge length / 2^levels. Contact forces are
+  /// loads for the criteria (CutState::external_forces), a parent is not coarsened while a
+  /// contact force acts on its region, and a state carried to a new cut is pushed out of the
+  /// obstacles where new vertices on the old field lie inside one
+  /// (Simulation::push_out_of_obstacles, CutChangeRecord::contact_correction). Throws InputError
+  /// for invalid settings or scene data.
   AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
                      const Material& material, std::vector<DirichletSpec> dirichlet,
                      const std::vector<RegionLoad>& loads, std::optional<GroundPlane> ground,
                      const Vector3d& gravity, const SolverSettings& settings,
-                     std::vector<Obstacle> obstacles = {});
+                     std::vector<Obstacle> obstacles = {},
+                     std::vector<RootPoint> contact_surface = {});
   ~AdaptiveSimulation() override;
   AdaptiveSimulation(const AdaptiveSimulation&) = delete;
   AdaptiveSimulation& operator=(const AdaptiveSimulation&) = delete;
@@ -201,6 +212,11 @@ class AdaptiveSimulation final : public SimulationRun {
   const ToleranceReport& tolerance_report() const { return m_report; }
   /// Mode precomputed: the window of the schedule in use.
   std::size_t precomputed_window() const { return m_window; }
+  /// Obstacles: the largest depth of any contact point inside an obstacle over the accepted
+  /// steps [m], the contact pairs after each accepted step, and the barrier stiffness [N/m].
+  double max_penetration() const { return m_max_penetration; }
+  const std::vector<Index>& contact_counts() const { return m_contact_counts; }
+  double contact_stiffness() const { return m_contact_stiffness; }
 
  private:
   void make_dirichlet_exact();
@@ -225,6 +241,9 @@ class AdaptiveSimulation final : public SimulationRun {
   bool children_stable(NodeId n) const;
   bool m_failed = false;  ///< a cut change threw: the cut no longer matches the Simulation
   void record_sample();
+  /// Obstacles: the contact record of the step just accepted (before a coarsening rebuilds the
+  /// Simulation).
+  void record_contact_step();
   void keep_kinetic_energy(const FlatTreeMesh& old_flat, const HangingConstraints& old_constraints,
                            const VectorXd& old_dof_mass, double old_kinetic_energy,
                            const Vector3d& old_momentum);
@@ -242,6 +261,17 @@ class AdaptiveSimulation final : public SimulationRun {
   std::unique_ptr<TreePointLocator> m_locator;
   std::unique_ptr<RefinementController> m_controller;
   std::vector<Obstacle> m_obstacles;
+  std::vector<RootPoint> m_contact_surface;
+  double m_contact_stiffness = 0.0;
+  double m_max_penetration = 0.0;
+  std::vector<Index> m_contact_counts;
+  /// Active nodes a contact force acts on, and their ancestors (not coarsened into).
+  std::unordered_set<NodeId> m_in_contact;
+  /// Obstacles, contact points and barrier stiffness of the current cut into `options`.
+  void add_contact(SimulationOptions& options) const;
+  /// The external loads the criteria see: m_mesh_external plus the contact forces (updating
+  /// m_in_contact).
+  VectorXd criteria_loads(const Simulation& simulation);
   std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
   /// Loads with an amplitude, each on the finest level.
   std::vector<std::pair<Amplitude, std::vector<PointLoad>>> m_timed_point_loads;

@@ -7,6 +7,7 @@
 /// StressJumpIndicator (refinement_stress_jump_indicator.hpp, for comparison).
 ///
 /// Also the stress measures shared by the indicators and the controller's coarsening test.
+#include <array>
 #include <string>
 
 #include "strata/core/common/types.hpp"
@@ -23,6 +24,11 @@ class RefinementIndicator {
   virtual std::string name() const = 0;
   /// η per flat tet of `state` (resized to #T, dimensionless, ≥ 0).
   virtual void evaluate(const CutState& state, VectorXd& eta) const = 0;
+  /// The indicator the parent (at `parent_level`) of the eight sibling flat tets `children`
+  /// would have after they merge, in η's units; +∞ when the indicator cannot tell (then the
+  /// controller merges only siblings whose stresses agree).
+  virtual double merge_indicator(const CutState& state, const std::array<int, 8>& children,
+                                 int parent_level) const;
 };
 
 /// Frobenius norm ‖σ‖_F of a symmetric tensor in Voigt form [xx yy zz xy yz xz]

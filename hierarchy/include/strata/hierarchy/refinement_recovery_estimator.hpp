@@ -56,6 +56,12 @@ class RecoveryIndicator final : public RefinementIndicator {
   explicit RecoveryIndicator(double tolerance);
   std::string name() const override { return "recovery"; }
   void evaluate(const CutState& state, VectorXd& eta) const override;
+  /// The energy a merge removes, Σ_k 2 V_k ψ(E_k − Ē) over the children (Ē their
+  /// volume-weighted mean Green strain: the parent's one linear field), in the measure of the
+  /// parent's level against the finest and normalised by the tet's share of the tolerance as η:
+  /// siblings in a region of low strain merge even where their stresses differ relatively.
+  double merge_indicator(const CutState& state, const std::array<int, 8>& children,
+                         int parent_level) const override;
 
  private:
   double m_tolerance;

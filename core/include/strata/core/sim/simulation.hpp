@@ -90,6 +90,9 @@ struct SimulationOptions {
   /// through their barycentric weights): the barrier and friction act on them too and their
   /// forces reach the DOFs through the weights.
   std::vector<ContactPoint> contact_points;
+  /// Barrier stiffness κ [N/m] of the obstacles; 0: E × this mesh's mean edge length. A driver
+  /// that runs one scene on several meshes (the hierarchy's cuts) fixes it for all of them.
+  double contact_stiffness = 0.0;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
@@ -219,7 +222,21 @@ class Simulation final : public SimulationRun {
   /// Of those, the SimulationOptions::contact_points.
   Index extra_contact_points() const { return m_extra_contact_points; }
   const std::vector<Index>& contact_counts() const { return m_contact_counts; }
+  /// Depth of the deepest contact point inside an obstacle after the last step [m] (≤ 0 when
+  /// none is inside; 0 before the first step).
+  double last_penetration() const { return m_last_penetration; }
   VectorXd contact_forces() const;
+  /// The barrier's (normal) contact forces at the current state on the mesh vertices, 3·#V [N]:
+  /// each contact point's force spread over its mesh vertices by its weights (hanging vertices
+  /// keep their share; a driver reads them as loads). Zero without obstacles.
+  VectorXd mesh_contact_forces() const;
+  /// Moves free DOF vertices so that no contact point lies deeper than `depth` × the contact
+  /// tolerance inside an obstacle at the current time (each deeper point is pushed out along ∇φ
+  /// to the surface, its correction shared over its DOF vertices by weight, repeated up to 20
+  /// times). For a state carried over from another mesh (a cut change near curved obstacles,
+  /// where new vertices on the old linear field can lie inside). Returns the largest correction of
+  /// a DOF vertex [m] (0 when the state was feasible); velocities are unchanged.
+  double push_out_of_obstacles(double depth = 0.5);
   /// Whether the material is plastic.
   bool is_plastic() const { return m_material.plasticity.has_value(); }
   /// Plastic state per mesh tet (empty unless is_plastic()).
@@ -275,7 +292,10 @@ class Simulation final : public SimulationRun {
   /// Mesh-vertex contact points carried to the DOFs through the embedding's rows.
   std::vector<ContactPoint> embed_points(const std::vector<ContactPoint>& points) const;
   std::unique_ptr<ContactTerm> m_contact;  ///< mirrors the stepper's, lagged at the last step
+  std::vector<ContactPoint> m_mesh_contact_points;  ///< the same points on mesh vertices
   double m_max_penetration = 0.0;
+  double m_last_penetration = 0.0;
+  long m_contact_step = -1;  ///< step index of the last contact record
   std::vector<Index> m_contact_counts;
   void record_contact(const VectorXd& q_start, double t0, double t1);
   SimulationCounters m_newton;  ///< Newton and plasticity fields only

@@ -68,6 +68,16 @@ class ContactTerm final : public EnergyTerm {
   /// Adds the barrier's (normal) contact forces −∂b/∂q at the end-of-step placement into `f`;
   /// returns the vertex–obstacle pairs in contact (φ < 0).
   Index add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const;
+  /// Moves the free DOFs of `q` (`constrained`: 3·#Q mask, as Problem::constrained) so that no
+  /// point lies deeper than `depth` × d̂ inside an obstacle at the end-of-step placement: each
+  /// deeper point is lifted to the surface along ∇φ by the least-norm move of its free vertices,
+  /// repeated up to 20 times (points sharing vertices). Returns the largest move of a vertex [m]
+  /// (0 when q was feasible). For a start that the barrier's domain excludes: an obstacle that
+  /// moved into the body within a step, or a state carried over from another mesh.
+  double push_out(VectorXd& q, const std::vector<char>& constrained, double depth) const;
+  /// The barrier's force on each point (num_points() entries, summed over the obstacles; zero
+  /// where no obstacle is within d̂).
+  std::vector<Vector3d> normal_point_forces(ConstRef<VectorXd> q) const;
   Index num_points() const { return static_cast<Index>(m_points.size()); }
   /// Position of point p at DOF state q.
   Vector3d position(ConstRef<VectorXd> q, Index p) const;

@@ -1,0 +1,228 @@
+// Obstacles on the hierarchy (AdaptiveSimulation, "Contact"): full mode against core on the
+// leaves with the same barrier, a block dropped on a sphere on an adaptive cut stays within the
+// tolerance, fine contact points embedded in a coarse cut carry the body where its vertices do
+// not touch, a sphere sliding over a clamped slab is refined under and released behind, and the
+// push-out of a transferred state.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "adaptive_test_utils.hpp"
+#include "strata/core/mesh/point_location.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/simulation.hpp"
+#include "strata/hierarchy/adaptive_simulation.hpp"
+
+namespace strata {
+namespace {
+
+using testing::hierarchy;
+using testing::rubber;
+
+Obstacle sphere_obstacle(const Vector3d& center, double radius) {
+  Obstacle obstacle;
+  obstacle.name = "sphere";
+  obstacle.distance = [center, radius](const Vector3d& p, Vector3d& gradient) {
+    const Vector3d r = p - center;
+    gradient = r.normalized();
+    return r.norm() - radius;
+  };
+  return obstacle;
+}
+
+/// Error-controlled adaptive settings (recovery estimate, in-step refinement) at `tolerance`.
+HierarchySettings error_controlled(int levels, double tolerance) {
+  HierarchySettings settings;
+  settings.levels = levels;
+  settings.mode = HierarchyMode::adaptive;
+  settings.tolerance = tolerance;
+  return settings;
+}
+
+TEST(AdaptiveContact, FullModeEqualsCoreOnTheLeavesWithTheSameBarrier) {
+  const TetMesh coarse =
+      box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {1, 1, 1});
+  const std::vector<Obstacle> obstacles = {sphere_obstacle(Vector3d::Zero(), 0.2)};
+  SolverSettings settings;
+  settings.dt = 2e-3;
+  settings.duration = 0.16;
+  const Vector3d gravity(0, 0, -9.81);
+  AdaptiveSimulation full(coarse, hierarchy(1, HierarchyMode::full), rubber(), {}, {},
+                          std::nullopt, gravity, settings, obstacles);
+  SimulationOptions options;
+  options.obstacles = obstacles;
+  options.contact_stiffness = full.contact_stiffness();
+  Simulation leaves(full.flat().mesh, rubber(), {}, {}, std::nullopt, gravity, settings,
+                    std::move(options));
+  while (!leaves.finished()) {
+    full.advance();
+    leaves.advance();
+  }
+  EXPECT_GT(leaves.max_penetration(), 0.0);  // it landed
+  const double scale = (leaves.positions() - leaves.model().rest_positions()).norm();
+  EXPECT_LE((full.simulation().positions() - leaves.positions()).norm(), 1e-9 * scale);
+  EXPECT_NEAR(full.max_penetration(), leaves.max_penetration(), 1e-9 * 0.2);
+  ASSERT_EQ(full.contact_counts().size(), leaves.contact_counts().size());
+  EXPECT_EQ(full.contact_counts(), leaves.contact_counts());
+}
+
+TEST(AdaptiveContact, BlockDroppedOnASphereStaysWithinTheToleranceOnAnAdaptiveCut) {
+  const TetMesh coarse =
+      box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {2, 2, 2});
+  SolverSettings settings;
+  settings.dt = 2e-3;
+  settings.duration = 0.3;
+  AdaptiveSimulation sim(coarse, error_controlled(1, 0.01), rubber(), {}, {}, std::nullopt,
+                         Vector3d(0, 0, -9.81), settings, {sphere_obstacle(Vector3d::Zero(), 0.2)});
+  double lowest = 1.0;
+  while (!sim.finished()) {
+    sim.advance();
+    const VectorXd& x = sim.simulation().positions();
+    for (Index v = 0; v < x.size() / 3; ++v)
+      lowest = std::min(lowest, x.segment<3>(3 * v).norm() - 0.2);
+  }
+  const double tolerance = sim.simulation().contact_settings().distance;
+  EXPECT_GT(sim.max_penetration(), 0.0);  // it landed
+  EXPECT_LE(sim.max_penetration(), tolerance);
+  EXPECT_GE(lowest, -tolerance);
+  EXPECT_GT(*std::max_element(sim.contact_counts().begin(), sim.contact_counts().end()), 0);
+  EXPECT_EQ(static_cast<long>(sim.contact_counts().size()), sim.step_count());
+  EXPECT_GT(sim.changes().size(), 0u);  // the impact refined the cut
+  for (const CutChangeRecord& change : sim.changes())
+    EXPECT_LE(change.contact_correction, 0.1);  // a push-out is a small correction, if any
+}
+
+TEST(AdaptiveContact, FineContactPointsCarryABlockOnACoarseCut) {
+  // A block 5 cm above a plane, on the coarse cut of a 2-level tree. Material points 5 cm below
+  // its bottom (outside the mesh, as a bound fine surface's vertices can be) are embedded in the
+  // bottom roots and touch the plane: they, not the mesh vertices, hold the block up, and their
+  // forces reach the DOFs through their weights.
+  const TetMesh coarse = box_tet_mesh(Vector3d(0, 0, 0.05), Vector3d(0.1, 0.1, 0.15), {1, 1, 1});
+  const TetLocator locator(coarse.vertices, coarse.tets);
+  std::vector<RootPoint> surface;
+  for (double x : {0.02, 0.05, 0.08})
+    for (double y : {0.02, 0.05, 0.08}) {
+      const Vector3d inside(x, y, 0.051);  // the root holding the point just above it
+      const std::optional<TetLocation> root = locator.locate(inside, 1e-9);
+      ASSERT_TRUE(root.has_value());
+      surface.push_back({static_cast<NodeId>(root->tet), Vector3d(x, y, 0.0)});
+    }
+  SolverSettings settings;
+  settings.dt = 5e-3;
+  settings.duration = 0.6;
+  Material material = rubber();
+  material.mass_damping = 20.0;
+  const Vector3d gravity(0, 0, -9.81);
+  AdaptiveSimulation sim(coarse, hierarchy(2, HierarchyMode::uniform, 0), material, {}, {},
+                         std::nullopt, gravity, settings,
+                         {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())},
+                         surface);
+  while (!sim.finished()) sim.advance();
+  const Simulation& current = sim.simulation();
+  EXPECT_EQ(current.extra_contact_points(), 9);
+  const double tolerance = current.contact_settings().distance;
+  EXPECT_GT(sim.max_penetration(), 0.0);
+  EXPECT_LE(sim.max_penetration(), tolerance);
+  // The mesh vertices stay about 5 cm above the plane.
+  const VectorXd& x = current.positions();
+  double lowest_vertex = 1.0;
+  for (Index v = 0; v < x.size() / 3; ++v)
+    lowest_vertex = std::min(lowest_vertex, x[3 * v + 2]);
+  EXPECT_GT(lowest_vertex, 0.04);
+  // At rest, the contact forces carry the weight.
+  const VectorXd f = current.mesh_contact_forces();
+  double lift = 0.0;
+  for (Index v = 0; v < f.size() / 3; ++v)
+    lift += f[3 * v + 2];
+  const double weight = current.vertex_mass().sum() * 9.81;
+  EXPECT_NEAR(lift, weight, 0.02 * weight);
+}
+
+TEST(AdaptiveContact, ASlidingSphereIsRefinedUnderAndReleasedBehind) {
+  // A slab clamped at its base; a sphere comes in from the left and moves along it, indenting
+  // the top by 5 mm. The cut is refined where the sphere presses and coarsened again after it has
+  // passed.
+  const TetMesh coarse = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.4, 0.1, 0.05), {8, 2, 1});
+  const double radius = 0.05;
+  Obstacle sphere = sphere_obstacle(Vector3d(-0.06, 0.05, 0.05 + radius - 0.005), radius);
+  sphere.velocity = Vector3d(1.0, 0, 0);
+  SolverSettings settings;
+  settings.dt = 5e-3;
+  settings.duration = 0.4;
+  Material material = rubber();
+  material.mass_damping = 50.0;
+  HierarchySettings h = error_controlled(1, 0.01);
+  h.criteria.min_steps_between_changes = 5;
+  h.adapt_every = 5;
+  AdaptiveSimulation sim(coarse, h, material,
+                         {testing::fixed_plane("fixed", Vector3d::Zero(), Vector3d::UnitZ())}, {},
+                         std::nullopt, Vector3d::Zero(), settings, {sphere});
+  // Mean level of the active tets with centroid x in [lo, hi].
+  const auto mean_level = [&](double lo, double hi) {
+    const VectorXi levels = sim.cell_levels();
+    const FlatTreeMesh& flat = sim.flat();
+    double sum = 0.0, count = 0.0;
+    for (Index t = 0; t < flat.mesh.tets.rows(); ++t) {
+      double x = 0.0;
+      for (int k = 0; k < 4; ++k)
+        x += 0.25 * flat.mesh.vertices(flat.mesh.tets(t, k), 0);
+      if (x < lo || x > hi) continue;
+      sum += levels[t];
+      count += 1.0;
+    }
+    return count > 0.0 ? sum / count : 0.0;
+  };
+  double left_under = -1.0, right_under = -1.0, left_after = -1.0;
+  while (!sim.finished()) {
+    sim.advance();
+    const double t = sim.time();
+    if (std::abs(t - 0.16) < 1e-9) {  // sphere centre at x = 0.10
+      left_under = mean_level(0.05, 0.15);
+      right_under = mean_level(0.3, 0.4);
+    }
+  }
+  left_after = mean_level(0.05, 0.15);  // sphere centre at x = 0.34
+  EXPECT_GT(left_under, 0.5);            // refined where the sphere pressed
+  EXPECT_LT(right_under, 0.1);           // not yet where it had not arrived
+  EXPECT_LT(left_after, 0.5 * left_under);  // released behind it
+  EXPECT_LE(sim.max_penetration(), sim.simulation().contact_settings().distance);
+  Index refined = 0, coarsened = 0;
+  for (const CutChangeRecord& change : sim.changes()) {
+    refined += change.refined;
+    coarsened += change.coarsened;
+  }
+  EXPECT_GT(refined, 0);
+  EXPECT_GT(coarsened, 0);
+}
+
+TEST(AdaptiveContact, PushOutMovesAnInfeasibleStateToTheSurface) {
+  // A block whose bottom vertices are moved 3 mm into a plane (deeper than the 1 mm tolerance):
+  // the push-out lifts them to the plane and leaves the others.
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+  options.first_step = 1;  // a continued run: its state comes from set_state
+  SolverSettings settings;
+  settings.dt = 1e-3;
+  settings.duration = 1.0;
+  settings.contact_distance = 1e-3;
+  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
+                 std::move(options));
+  VectorXd x = flatten(mesh.vertices);
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -3e-3;
+  sim.set_state(x, VectorXd::Zero(x.size()));
+  EXPECT_NEAR(sim.push_out_of_obstacles(), 3e-3, 1e-12);
+  for (Index v = 0; v < mesh.vertices.rows(); ++v) {
+    const double z = sim.positions()[3 * v + 2];
+    EXPECT_GE(z, -0.5e-3);
+    if (mesh.vertices(v, 2) > 0.0) EXPECT_EQ(z, mesh.vertices(v, 2));
+  }
+  EXPECT_EQ(sim.push_out_of_obstacles(), 0.0);  // feasible now
+  sim.advance();                                 // and the barrier accepts it
+}
+
+}  // namespace
+}  // namespace strata
