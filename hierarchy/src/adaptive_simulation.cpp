@@ -119,14 +119,11 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
     throw InputError(where + ".cut: mode \"precomputed\" needs a precomputed cut");
 }
 
-AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
-                                       const Material& material,
-                                       std::vector<DirichletSpec> dirichlet,
-                                       const std::vector<RegionLoad>& loads,
-                                       std::optional<GroundPlane> ground, const Vector3d& gravity,
-                                       const SolverSettings& settings,
-                                       std::vector<Obstacle> obstacles,
-                                       std::vector<RootPoint> contact_surface)
+AdaptiveSimulation::AdaptiveSimulation(
+    const TetMesh& coarse, const HierarchySettings& hierarchy, const Material& material,
+    std::vector<DirichletSpec> dirichlet, const std::vector<RegionLoad>& loads,
+    std::optional<GroundPlane> ground, const Vector3d& gravity, const SolverSettings& settings,
+    std::vector<Obstacle> obstacles, std::vector<RootPoint> contact_surface)
     : m_settings(hierarchy),
       m_material(material),
       m_dirichlet(std::move(dirichlet)),
@@ -144,6 +141,10 @@ AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySet
   const auto start = Clock::now();
   m_tree = std::make_unique<TetTree>(coarse, m_settings.levels);
   m_tolerance = region_tolerance(coarse.vertices);
+  // Strains below the stress floor are round-off (a body in free fall): the estimate is relative
+  // to at least the energy of that strain over the body.
+  m_energy_floor = m_material.youngs_modulus * tet_rest_volumes(coarse).sum() *
+                   m_settings.criteria.stress_floor * m_settings.criteria.stress_floor;
   if (!m_obstacles.empty())
     m_contact_stiffness = m_material.youngs_modulus *
                           mean_edge_length(coarse.vertices, coarse.tets) /
@@ -238,6 +239,7 @@ void AdaptiveSimulation::initial_adaptation() {
     const VectorXd loads = criteria_loads(*solve);
     CutState state{*m_tree,    flat, solve->positions(), fields, loads, solve->vertex_mass(),
                    m_material, 0,    &m_load_traction};
+    state.solution_energy_scale = m_energy_floor;
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
     if (m_settings.indicator == "recovery" && estimate.relative_error <= m_settings.tolerance)
@@ -464,7 +466,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const VectorXd loads = criteria_loads(sim);
   CutState state{*m_tree,           flat,       sim.positions(),  fields,          loads,
                  sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
-  state.solution_energy_scale = m_energy_scale;
+  state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
   state.recovery_estimate = &m_estimate;
@@ -572,7 +574,7 @@ RecoveryEstimate AdaptiveSimulation::estimate_error() {
     CutState state{*m_tree,    m_constrained->flat, sim.positions(),
                    fields,     m_mesh_external,     sim.vertex_mass(),
                    m_material, sim.step_count(),    &m_load_traction};
-    state.solution_energy_scale = m_energy_scale;
+    state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
     m_estimate = recovery_error_estimate(state);
     m_estimate_valid = true;
   }

@@ -5,8 +5,7 @@
 
 namespace strata {
 
-double RefinementIndicator::merge_indicator(const CutState&, const std::array<int, 8>&,
-                                            int) const {
+double RefinementIndicator::merge_indicator(const CutState&, const std::array<int, 8>&, int) const {
   return std::numeric_limits<double>::infinity();
 }
 

@@ -88,8 +88,7 @@ void RecoveryIndicator::evaluate(const CutState& state, VectorXd& eta) const {
   eta = (estimate.element_error_sq / share).cwiseSqrt();
 }
 
-double RecoveryIndicator::merge_indicator(const CutState& state,
-                                          const std::array<int, 8>& children,
+double RecoveryIndicator::merge_indicator(const CutState& state, const std::array<int, 8>& children,
                                           int parent_level) const {
   RecoveryEstimate computed;
   if (state.recovery_estimate == nullptr) computed = recovery_error_estimate(state);

@@ -144,7 +144,8 @@ TEST(CliContact, AdaptiveDropOnASphereFollowsFullResolution) {
     scene["output"]["every"] = 10;
     scene["hierarchy"] = {{"levels", 1}, {"mode", mode}};
     write_text(folder.path() / (std::string(mode) + ".json"), scene.dump(2));
-    const CliResult result = run_strata(std::string("run ") + mode + ".json --quiet", folder.path());
+    const CliResult result =
+        run_strata(std::string("run ") + mode + ".json --quiet", folder.path());
     ASSERT_EQ(result.exit_code, 0) << result.err;
   }
   const json full = read_json(folder.path() / "out" / "full" / "stats.json");
@@ -170,6 +171,42 @@ TEST(CliContact, AdaptiveDropOnASphereFollowsFullResolution) {
   }
   EXPECT_GT(largest, 0.01);  // it fell about 2 cm
   EXPECT_LT(difference, 0.02 * largest);
+}
+
+TEST(CliContact, TheArmadilloDroppedOnTheGroundStaysWithinTheTolerance) {
+  // The armadillo scan (26,002 vertices) meshed coarsely, on an adaptive cut, dropped 26 mm onto
+  // the ground: its fine surface's vertices are contact points through the tree, and none of
+  // them gets deeper than the tolerance.
+  const std::filesystem::path model = std::filesystem::path(STRATA_MODELS_DIR) / "armadillo.off";
+  if (!std::filesystem::exists(model)) GTEST_SKIP() << "no armadillo.off";
+  TempFolder folder;
+  json scene = json::parse(R"({
+    "mesh": {"cell_size": 20},
+    "material": {"model": "neohookean", "youngs_modulus": 5000, "poisson_ratio": 0.4,
+                 "density": 1e-6, "damping": {"mass": 2.0}},
+    "gravity": [0, -9810, 0],
+    "ground": {"point": [0, -80, 0], "normal": [0, 1, 0], "friction": 0.5},
+    "solver": {"mode": "dynamic", "dt": 0.005, "duration": 0.12},
+    "output": {"every": 6},
+    "hierarchy": {"levels": 1, "tolerance": 0.05}
+  })");
+  scene["mesh"]["surface"] = model.string();
+  write_text(folder.path() / "drop.json", scene.dump(2));
+  const CliResult result = run_strata("run drop.json --quiet", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::filesystem::path out = folder.path() / "out" / "drop";
+  const json stats = read_json(out / "stats.json");
+  ASSERT_TRUE(stats.contains("contact"));
+  const double tolerance = stats["contact"]["tolerance"];
+  EXPECT_EQ(stats["contact"]["surface_points"].get<Index>(), 26002);
+  EXPECT_GT(stats["contact"]["max_penetration"].get<double>(), 0.0);  // it landed
+  EXPECT_LE(stats["contact"]["max_penetration"].get<double>(), tolerance);
+  EXPECT_GT(stats["contact"]["active_contacts"].back().get<int>(), 0);
+  // The fine surface as written: no vertex below the ground by more than the tolerance.
+  const MatrixX3d last = read_vtp_points(out / "drop_surface_000004.vtp");
+  ASSERT_EQ(last.rows(), 26002);
+  EXPECT_GE(last.col(1).minCoeff(), -80.0 - tolerance);
+  EXPECT_LT(last.col(1).minCoeff(), -80.0 + 1.0);
 }
 
 TEST(CliContact, GroundIsAPlaneObstacleThatHoldsStaticFriction) {

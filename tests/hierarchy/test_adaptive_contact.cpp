@@ -49,8 +49,8 @@ TEST(AdaptiveContact, FullModeEqualsCoreOnTheLeavesWithTheSameBarrier) {
   settings.dt = 2e-3;
   settings.duration = 0.16;
   const Vector3d gravity(0, 0, -9.81);
-  AdaptiveSimulation full(coarse, hierarchy(1, HierarchyMode::full), rubber(), {}, {},
-                          std::nullopt, gravity, settings, obstacles);
+  AdaptiveSimulation full(coarse, hierarchy(1, HierarchyMode::full), rubber(), {}, {}, std::nullopt,
+                          gravity, settings, obstacles);
   SimulationOptions options;
   options.obstacles = obstacles;
   options.contact_stiffness = full.contact_stiffness();
@@ -117,9 +117,9 @@ TEST(AdaptiveContact, FineContactPointsCarryABlockOnACoarseCut) {
   const Vector3d gravity(0, 0, -9.81);
   AdaptiveSimulation sim(coarse, hierarchy(2, HierarchyMode::uniform, 0), material, {}, {},
                          std::nullopt, gravity, settings,
-                         {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())},
-                         surface);
-  while (!sim.finished()) sim.advance();
+                         {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}, surface);
+  while (!sim.finished())
+    sim.advance();
   const Simulation& current = sim.simulation();
   EXPECT_EQ(current.extra_contact_points(), 9);
   const double tolerance = current.contact_settings().distance;
@@ -183,9 +183,9 @@ TEST(AdaptiveContact, ASlidingSphereIsRefinedUnderAndReleasedBehind) {
       right_under = mean_level(0.3, 0.4);
     }
   }
-  left_after = mean_level(0.05, 0.15);  // sphere centre at x = 0.34
-  EXPECT_GT(left_under, 0.5);            // refined where the sphere pressed
-  EXPECT_LT(right_under, 0.1);           // not yet where it had not arrived
+  left_after = mean_level(0.05, 0.15);      // sphere centre at x = 0.34
+  EXPECT_GT(left_under, 0.5);               // refined where the sphere pressed
+  EXPECT_LT(right_under, 0.1);              // not yet where it had not arrived
   EXPECT_LT(left_after, 0.5 * left_under);  // released behind it
   EXPECT_LE(sim.max_penetration(), sim.simulation().contact_settings().distance);
   Index refined = 0, coarsened = 0;
@@ -221,7 +221,7 @@ TEST(AdaptiveContact, PushOutMovesAnInfeasibleStateToTheSurface) {
     if (mesh.vertices(v, 2) > 0.0) EXPECT_EQ(z, mesh.vertices(v, 2));
   }
   EXPECT_EQ(sim.push_out_of_obstacles(), 0.0);  // feasible now
-  sim.advance();                                 // and the barrier accepts it
+  sim.advance();                                // and the barrier accepts it
 }
 
 }  // namespace

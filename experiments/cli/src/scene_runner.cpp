@@ -284,15 +284,14 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   if (simulation.has_obstacles()) {
     const ContactSettings& contact = simulation.contact_settings();
     const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
-    stats["contact"] = {{"max_penetration", adaptive ? adaptive->max_penetration()
-                                                     : simulation.max_penetration()},
-                        {"tolerance", contact.distance},
-                        {"barrier_stiffness", contact.stiffness},
-                        {"friction_slip", contact.friction_slip},
-                        {"points", simulation.contact_points()},
-                        {"surface_points", simulation.extra_contact_points()},
-                        {"active_contacts", adaptive ? adaptive->contact_counts()
-                                                     : simulation.contact_counts()}};
+    stats["contact"] = {
+        {"max_penetration", adaptive ? adaptive->max_penetration() : simulation.max_penetration()},
+        {"tolerance", contact.distance},
+        {"barrier_stiffness", contact.stiffness},
+        {"friction_slip", contact.friction_slip},
+        {"points", simulation.contact_points()},
+        {"surface_points", simulation.extra_contact_points()},
+        {"active_contacts", adaptive ? adaptive->contact_counts() : simulation.contact_counts()}};
   }
   if (scene.material.plasticity) {
     const Plasticity& plasticity = *scene.material.plasticity;

@@ -41,7 +41,15 @@ void VtkSeries::write_frame(double time, const Simulation& simulation, const Vec
   fields.add_cell_data("stress", Eigen::MatrixXd(tet_fields.cauchy_stress));
   fields.add_cell_data("von_mises", Eigen::MatrixXd(tet_fields.von_mises));
   if (simulation.has_obstacles()) {
-    fields.add_point_data("contact_force", Eigen::MatrixXd(unflatten(simulation.contact_forces())));
+    // The obstacles' forces on the DOFs (normal and friction), at the DOF vertices; a hanging
+    // vertex's share is carried by the vertices it follows.
+    const VectorXd on_dofs = simulation.contact_forces();
+    const EmbeddedElasticModel& model = simulation.embedded_model();
+    VectorXd on_mesh = VectorXd::Zero(3 * mesh.vertices.rows());
+    for (Index q = 0; q < model.num_dof_vertices(); ++q)
+      on_mesh.segment<3>(3 * (model.is_identity() ? q : model.dof_vertices()[q])) =
+          on_dofs.segment<3>(3 * q);
+    fields.add_point_data("contact_force", Eigen::MatrixXd(unflatten(on_mesh)));
   }
   if (simulation.is_plastic()) {
     fields.add_cell_data("plastic_strain",

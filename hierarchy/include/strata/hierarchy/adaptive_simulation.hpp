@@ -287,6 +287,8 @@ class AdaptiveSimulation final : public SimulationRun {
   double m_stepping_seconds = 0.0;
   ToleranceReport m_report;
   double m_energy_scale = 0.0;  ///< largest ‖u‖_E² of the accepted steps so far [J]
+  /// E × volume × stress_floor²: the smallest ‖u‖_E² an estimate is relative to [J].
+  double m_energy_floor = 0.0;
   RecoveryEstimate m_estimate;  ///< of the current state while m_estimate_valid
   bool m_estimate_valid = false;
 };
