@@ -13,7 +13,8 @@ bar per field shared by the frames. The surface .vtp frames of a bound fine surf
 the same way (point fields are averaged per triangle). Fields: any cell field of the frame —
 `level` (active tree level, integer colours), `von_mises` [Pa], `plastic_strain`, `stress` or
 `green_strain` (the first Voigt component) — or a point field (`displacement` magnitude).
-`--up` names the model's vertical axis (default z; y for models such as the armadillo scan).
+Continuous fields are coloured up to their 99th percentile over the frames (the rest in the top
+colour). `--up` names the model's vertical axis (default z; y for models such as the armadillo scan).
 Needs /usr/bin/python3 (matplotlib, meshio, numpy; Pillow for --gif).
 """
 import argparse
@@ -85,6 +86,16 @@ def positions(mesh, exaggerate):
     return points
 
 
+def colour_range(per_frame, integer):
+    """(lo, hi) of a field over the frames: the whole range for integer fields (levels), else up
+    to the 99th percentile, so that a few peak values (a contact, a corner) do not darken the
+    rest; values above are drawn in the top colour."""
+    values = np.concatenate(per_frame)
+    lo = float(values.min())
+    hi = float(values.max()) if integer else float(np.percentile(values, 99))
+    return lo, max(hi, lo)
+
+
 # Column order that puts the model's up axis on the plot's vertical axis (a cyclic permutation:
 # the picture is not mirrored).
 UP = {"x": [1, 2, 0], "y": [2, 0, 1], "z": [0, 1, 2]}
@@ -114,9 +125,8 @@ def render(frames, fields, out, titles, view, exaggerate, up="z"):
     figure = plt.figure(figsize=(4.2 * len(fields), 3.4 * len(frames)))
     for column, field in enumerate(fields):
         per_frame = [values(m, field, f, o) for m, (f, o) in zip(meshes, surfaces)]
-        lo = min(v.min() for v in per_frame)
-        hi = max(v.max() for v in per_frame)
         integer = field == "level"
+        lo, hi = colour_range(per_frame, integer)
         if integer:
             cmap = plt.get_cmap("viridis", int(hi - lo) + 1)
             norm = matplotlib.colors.Normalize(lo - 0.5, hi + 0.5)
@@ -168,8 +178,7 @@ def animate(pvd, field, out, fps, view, exaggerate, up="z"):
     meshes = [load(f) for _, f in frames]
     surfaces = [boundary(m) for m in meshes]
     per_frame = [values(m, field, f, o) for m, (f, o) in zip(meshes, surfaces)]
-    lo = min(v.min() for v in per_frame)
-    hi = max(v.max() for v in per_frame)
+    lo, hi = colour_range(per_frame, field == "level")
     cmap = plt.get_cmap("viridis" if field == "level" else "inferno")
     norm = matplotlib.colors.Normalize(lo, hi if hi > lo else lo + 1e-30)
     figure = plt.figure(figsize=(5, 4))

@@ -207,6 +207,7 @@ TEST(CliContact, TheArmadilloDroppedOnTheGroundStaysWithinTheTolerance) {
   ASSERT_EQ(last.rows(), 26002);
   EXPECT_GE(last.col(1).minCoeff(), -80.0 - tolerance);
   EXPECT_LT(last.col(1).minCoeff(), -80.0 + 1.0);
+  EXPECT_THAT(read_text(out / "drop_surface_000004.vtp"), HasSubstr("Name=\"contact_force\""));
 }
 
 TEST(CliContact, GroundIsAPlaneObstacleThatHoldsStaticFriction) {

@@ -315,7 +315,7 @@ void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {
 VectorXd Simulation::mesh_contact_forces() const {
   VectorXd f = VectorXd::Zero(3 * m_mesh.vertices.rows());
   if (!m_contact) return f;
-  const std::vector<Vector3d> point_forces = m_contact->normal_point_forces(m_x);
+  const std::vector<Vector3d> point_forces = m_contact->point_forces(m_x, false);
   for (size_t p = 0; p < point_forces.size(); ++p) {
     if (point_forces[p].isZero()) continue;
     const ContactPoint& point = m_mesh_contact_points[p];
@@ -323,6 +323,13 @@ VectorXd Simulation::mesh_contact_forces() const {
       f.segment<3>(3 * point.vertices[k]) += point.weights[k] * point_forces[p];
   }
   return f;
+}
+
+std::vector<Vector3d> Simulation::surface_contact_forces() const {
+  if (!m_contact) return {};
+  std::vector<Vector3d> forces = m_contact->point_forces(m_x, true);
+  forces.erase(forces.begin(), forces.end() - m_extra_contact_points);
+  return forces;
 }
 
 double Simulation::push_out_of_obstacles(double depth) {

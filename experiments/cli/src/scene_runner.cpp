@@ -461,8 +461,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
       const MatrixX3d surface_positions =
           adaptive ? MatrixX3d(surface->rest().vertices + adaptive->displacements(surface_roots))
                    : surface->positions(simulation->positions());
-      vtk->write_surface_frame(time, surface_positions, surface->rest().triangles,
-                               surface->fields(surface_positions));
+      VtuFields fields = surface->fields(surface_positions);
+      const std::vector<Vector3d> contact = simulation->surface_contact_forces();
+      if (static_cast<Index>(contact.size()) == surface_positions.rows()) {
+        Eigen::MatrixXd forces(surface_positions.rows(), 3);
+        for (Index i = 0; i < forces.rows(); ++i)
+          forces.row(i) = contact[i].transpose();
+        fields.add_point_data("contact_force", std::move(forces));
+      }
+      vtk->write_surface_frame(time, surface_positions, surface->rest().triangles, fields);
     }
     ++summary.frames;
   };

@@ -133,24 +133,35 @@ double ContactTerm::value(ConstRef<VectorXd> q) const {
   return energy;
 }
 
-void ContactTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
-  const auto scatter = [&](Index p, const Vector3d& force) {
-    const ContactPoint& point = m_points[p];
-    for (size_t k = 0; k < point.vertices.size(); ++k)
-      gradient.segment<3>(3 * point.vertices[k]) += point.weights[k] * force;
-  };
+template <class Visit>
+void ContactTerm::visit_gradients(ConstRef<VectorXd> q, bool friction, Visit&& visit) const {
   for (const Obstacle& obstacle : m_obstacles)
     for (Index p = 0; p < num_points(); ++p) {
       Vector3d n;
       const double d = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
       if (!(d > 0.0) || d >= m_settings.distance) continue;
-      scatter(p, barrier_derivative(d) * n);
+      visit(p, Vector3d(barrier_derivative(d) * n));
     }
+  if (!friction) return;
   const double epsilon = m_settings.friction_slip;
   for (const FrictionPair& pair : m_friction) {
     const Eigen::Vector2d u = pair.basis.transpose() * (position(q, pair.point) - pair.reference);
-    scatter(pair.point, pair.weight * f1_over_y(u.norm(), epsilon) * (pair.basis * u));
+    visit(pair.point, Vector3d(pair.weight * f1_over_y(u.norm(), epsilon) * (pair.basis * u)));
   }
+}
+
+void ContactTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
+  visit_gradients(q, true, [&](Index p, const Vector3d& g) {
+    const ContactPoint& point = m_points[p];
+    for (size_t k = 0; k < point.vertices.size(); ++k)
+      gradient.segment<3>(3 * point.vertices[k]) += point.weights[k] * g;
+  });
+}
+
+std::vector<Vector3d> ContactTerm::point_forces(ConstRef<VectorXd> q, bool friction) const {
+  std::vector<Vector3d> forces(m_points.size(), Vector3d::Zero());
+  visit_gradients(q, friction, [&](Index p, const Vector3d& g) { forces[p] -= g; });
+  return forces;
 }
 
 void ContactTerm::add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool) const {
@@ -243,17 +254,6 @@ double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained,
   for (Index v = 0; v < moved.size() / 3; ++v)
     largest = std::max(largest, moved.segment<3>(3 * v).norm());
   return largest;
-}
-
-std::vector<Vector3d> ContactTerm::normal_point_forces(ConstRef<VectorXd> q) const {
-  std::vector<Vector3d> forces(m_points.size(), Vector3d::Zero());
-  for (const Obstacle& obstacle : m_obstacles)
-    for (Index p = 0; p < num_points(); ++p) {
-      Vector3d n;
-      const double d = obstacle.distance_at(position(q, p), m_time, n) + m_settings.distance;
-      if (d > 0.0 && d < m_settings.distance) forces[p] -= barrier_derivative(d) * n;
-    }
-  return forces;
 }
 
 double ContactTerm::min_distance(ConstRef<VectorXd> q) const {

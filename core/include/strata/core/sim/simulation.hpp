@@ -230,6 +230,9 @@ class Simulation final : public SimulationRun {
   /// each contact point's force spread over its mesh vertices by its weights (hanging vertices
   /// keep their share; a driver reads them as loads). Zero without obstacles.
   VectorXd mesh_contact_forces() const;
+  /// The contact force (normal and friction) on each SimulationOptions::contact_points entry, in
+  /// their order [N]; empty without obstacles.
+  std::vector<Vector3d> surface_contact_forces() const;
   /// Moves free DOF vertices so that no contact point lies deeper than `depth` × the contact
   /// tolerance inside an obstacle at the current time (each deeper point is pushed out along ∇φ
   /// to the surface, its correction shared over its DOF vertices by weight, repeated up to 20

@@ -75,9 +75,9 @@ class ContactTerm final : public EnergyTerm {
   /// (0 when q was feasible). For a start that the barrier's domain excludes: an obstacle that
   /// moved into the body within a step, or a state carried over from another mesh.
   double push_out(VectorXd& q, const std::vector<char>& constrained, double depth) const;
-  /// The barrier's force on each point (num_points() entries, summed over the obstacles; zero
-  /// where no obstacle is within d̂).
-  std::vector<Vector3d> normal_point_forces(ConstRef<VectorXd> q) const;
+  /// The contact force on each point (num_points() entries, summed over the obstacles; zero
+  /// where none acts): the barrier's, and with `friction` the lagged friction's too.
+  std::vector<Vector3d> point_forces(ConstRef<VectorXd> q, bool friction) const;
   Index num_points() const { return static_cast<Index>(m_points.size()); }
   /// Position of point p at DOF state q.
   Vector3d position(ConstRef<VectorXd> q, Index p) const;
@@ -99,6 +99,10 @@ class ContactTerm final : public EnergyTerm {
     Eigen::Matrix<double, 3, 2> basis;
     Vector3d reference;  ///< x₀ + v_o Δt
   };
+  /// visit(p, ∂E/∂x_p) for the barrier of every point within d̂ of an obstacle, then (with
+  /// `friction`) for every friction pair; a point may be visited more than once.
+  template <class Visit>
+  void visit_gradients(ConstRef<VectorXd> q, bool friction, Visit&& visit) const;
   const std::vector<Obstacle>& m_obstacles;
   std::vector<ContactPoint> m_points;
   ContactSettings m_settings;
