@@ -11,7 +11,8 @@ SPEC.json (paths relative to the spec file):
    "tolerances": [0.05, 0.02, 0.01, 0.005],           # adaptive runs, hierarchy.tolerance
    "uniform_levels": "all",                           # or a list of levels below hierarchy.levels
    "set": {"solver.duration": 0.04},                  # overrides applied to every run (optional)
-   "quick": {"set": {...}, "tolerances": [...]},      # the short version run with --quick
+   "quick": {"set": {...}, "tolerances": [...],       # the short version run with --quick
+             "variants": [...]},                       # (the variants it keeps; default all)
    "variants": [{"name": "springs",                   # further runs compared with the full one
                  "scene": "../scenes/other.json",     # optional: another scene (same probes
                  "set": {...}}],                      #   and frames), optional overrides
@@ -95,10 +96,15 @@ def load_spec(path, quick=False):
     if quick:
         block = spec.get("quick", {})
         for key in block:
-            if key not in ("set", "tolerances"):
-                fail(f"{path}: quick: unknown key '{key}' (valid: set, tolerances)")
+            if key not in ("set", "tolerances", "variants"):
+                fail(f"{path}: quick: unknown key '{key}' (valid: set, tolerances, variants)")
         spec["set"] = {**spec["set"], **block.get("set", {})}
         spec["tolerances"] = block.get("tolerances", spec["tolerances"])
+        if "variants" in block:  # the variants the short version keeps (default: all)
+            keep = block["variants"]
+            if not isinstance(keep, list) or not all(isinstance(v, str) for v in keep):
+                fail(f"{path}: quick.variants: an array of variant names")
+            spec["variants"] = [v for v in spec.get("variants", []) if v.get("name") in keep]
     for i, tolerance in enumerate(spec["tolerances"]):
         if not isinstance(tolerance, (int, float)) or not 0 < tolerance < 1:
             fail(f"{path}: tolerances.{i}: must be a number in (0, 1)")

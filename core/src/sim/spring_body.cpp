@@ -220,8 +220,13 @@ SpringBodySimulation::SpringBodySimulation(SpringBody body, const Material& mate
                                            const std::vector<DirichletSpec>& dirichlet,
                                            const std::vector<RegionLoad>& loads,
                                            const std::optional<GroundPlane>& ground,
-                                           const Vector3d& gravity, const SolverSettings& settings)
-    : m_body(std::move(body)), m_material(material), m_settings(settings), m_ground(ground) {
+                                           const Vector3d& gravity, const SolverSettings& settings,
+                                           std::vector<Obstacle> obstacles)
+    : m_body(std::move(body)),
+      m_material(material),
+      m_settings(settings),
+      m_ground(ground),
+      m_obstacles(std::move(obstacles)) {
   validate_material(m_material, "material");
   validate_solver_settings(m_settings, "solver");
   if (m_settings.mode != SimulationMode::dynamic)
@@ -258,10 +263,49 @@ SpringBodySimulation::SpringBodySimulation(SpringBody body, const Material& mate
   m_body.springs.add_pattern(triplets);
   for (Index i = 0; i < 3 * V; ++i)
     triplets.emplace_back(i, i, 0.0);
+  if (!m_obstacles.empty())  // the contact Hessian's 3 × 3 block on each surface vertex
+    for (Index i = 0; i < m_body.num_surface; ++i)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          triplets.emplace_back(3 * i + a, 3 * i + b, 0.0);
   m_pattern.resize(3 * V, 3 * V);
   m_pattern.setFromTriplets(triplets.begin(), triplets.end());
   m_pattern.makeCompressed();
   apply_constraints(0.0, m_x, m_v);
+  if (!m_obstacles.empty()) {
+    for (const Obstacle& obstacle : m_obstacles)
+      validate_obstacle(obstacle);
+    const double diagonal =
+        (m_body.rest.colwise().maxCoeff() - m_body.rest.colwise().minCoeff()).norm();
+    double edges = 0.0;
+    for (Index f = 0; f < m_body.triangles.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        edges += (m_body.rest.row(m_body.triangles(f, k)) -
+                  m_body.rest.row(m_body.triangles(f, (k + 1) % 3)))
+                     .norm();
+    const double mean_edge = edges / (3.0 * static_cast<double>(m_body.triangles.rows()));
+    m_contact_settings.distance =
+        m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * diagonal;
+    m_contact_settings.stiffness = m_material.youngs_modulus * mean_edge;
+    m_contact_settings.friction_slip = m_settings.friction_slip > 0.0
+                                           ? m_settings.friction_slip
+                                           : 1e-3 * m_contact_settings.distance;
+    m_surface_points.resize(static_cast<std::size_t>(m_body.num_surface));
+    for (Index i = 0; i < m_body.num_surface; ++i)
+      m_surface_points[i] = static_cast<int>(i);
+    m_contact = std::make_unique<ContactTerm>(m_obstacles, m_surface_points, m_contact_settings);
+    m_contact->set_step(m_x, 0.0, 0.0);
+    for (const Obstacle& obstacle : m_obstacles)
+      for (Index p = 0; p < m_contact->num_points(); ++p) {
+        Vector3d gradient;
+        const double phi = obstacle.distance_at(m_contact->position(m_x, p), 0.0, gradient);
+        if (!(phi > -m_contact_settings.distance))
+          throw InputError(obstacle.name + ": surface vertex " + std::to_string(p) + " starts " +
+                           std::to_string(-phi) +
+                           " m inside the obstacle (more than the contact tolerance " +
+                           std::to_string(m_contact_settings.distance) + " m)");
+      }
+  }
 }
 
 void SpringBodySimulation::apply_constraints(double t, VectorXd& x, VectorXd& v) const {
@@ -351,6 +395,11 @@ bool SpringBodySimulation::try_implicit(double t1, double h) {
   energy.emplace<InertiaTerm>(mass).set_step(predicted, h);
   energy.emplace<SpringTerm>(m_body.springs);
   energy.emplace<ExternalWorkTerm>(f_ext).set_load_factor(1.0);
+  ContactTerm* contact = nullptr;
+  if (m_contact) {
+    contact = &energy.emplace<ContactTerm>(m_obstacles, m_surface_points, m_contact_settings);
+    contact->set_step(m_x, t1 - h, t1);
+  }
   if (!m_reduction) {
     m_reduction = std::make_unique<DofReduction>(m_pattern, m_constrained);
     m_solver = std::make_unique<SpdSolver>(LinearSolverKind::cholmod);
@@ -358,10 +407,17 @@ bool SpringBodySimulation::try_implicit(double t1, double h) {
   VectorXd q = predicted;
   VectorXd v_end = m_v;
   apply_constraints(t1, q, v_end);
+  if (contact != nullptr && !std::isfinite(contact->value(q))) {
+    // Newton needs a start inside the barrier's domain: the step's start, lifted out of an
+    // obstacle that moved into it.
+    q = m_x;
+    apply_constraints(t1, q, v_end);
+    if (!std::isfinite(contact->value(q))) contact->push_out(q, m_constrained, 0.5);
+  }
   VectorXd f_int = VectorXd::Zero(q.size());
   m_body.springs.add_forces(q, f_int);
   NewtonSettings settings;
-  settings.max_iterations = newton_iteration_limit(m_settings, false);
+  settings.max_iterations = newton_iteration_limit(m_settings, m_contact != nullptr);
   settings.tolerance = m_settings.newton_tolerance;
   settings.force_scale = f_int.norm() + f_ext.norm() + m_mass.cwiseProduct(m_v).norm() / h +
                          mass.cwiseProduct(q - predicted).norm() / (h * h);
@@ -384,7 +440,12 @@ bool SpringBodySimulation::try_implicit(double t1, double h) {
 }
 
 std::vector<GroupReaction> SpringBodySimulation::reactions() const {
-  const VectorXd f = forces(m_x, m_v, time());
+  VectorXd f = forces(m_x, m_v, time());
+  if (m_contact) {
+    VectorXd gradient = VectorXd::Zero(f.size());
+    m_contact->add_gradient(m_x, gradient);
+    f -= gradient;
+  }
   std::vector<GroupReaction> result;
   for (const DirichletGroup& group : m_groups) {
     GroupReaction reaction;
@@ -405,12 +466,20 @@ std::vector<GroupReaction> SpringBodySimulation::reactions() const {
 void SpringBodySimulation::advance() {
   if (finished()) throw std::logic_error("SpringBodySimulation::advance: finished");
   const double t1 = (m_steps + 1) * m_settings.dt;
+  const VectorXd x_start = m_x;
   if (m_settings.integrator == Integrator::implicit_euler) {
     step_implicit(t1);
   } else {
     step_explicit(t1);
+    if (m_contact) project_obstacle_contact(m_obstacles, t1, m_x, m_v, m_constrained);
   }
   if (m_ground) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
+  if (m_contact) {
+    m_contact->set_step(x_start, t1 - m_settings.dt, t1);
+    m_max_penetration = std::max(m_max_penetration, -m_contact->min_distance(m_x));
+    VectorXd unused = VectorXd::Zero(m_x.size());
+    m_contact_counts.push_back(m_contact->add_normal_forces(m_x, unused));
+  }
   ++m_steps;
   if (!m_x.allFinite() || !m_v.allFinite())
     throw DivergenceError("step " + std::to_string(m_steps) + " (t = " + std::to_string(t1) +

@@ -371,10 +371,9 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     if (scene.body.skeleton_springs) {
       if (!top.at("mesh").has("surface"))
         body.at("model").fail("skeleton_springs needs mesh.surface (a closed surface file)");
-      for (const char* key : {"hierarchy", "obstacles"})
-        if (top.has(key))
-          throw SceneKeyError(file_name, key, "not supported with body.model skeleton_springs",
-                              false);
+      if (top.has("hierarchy"))
+        throw SceneKeyError(file_name, "hierarchy",
+                            "not supported with body.model skeleton_springs", false);
       if (top.at("material").has("surface_springs") || top.at("material").has("plasticity"))
         throw SceneKeyError(file_name, "material",
                             "surface_springs and plasticity are not supported with body.model "

@@ -44,16 +44,16 @@ long planned_steps(const SolverSettings& settings) {
   return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
 }
 
-/// The scene's obstacles: `ground` first (a plane obstacle named "ground"), then `obstacles`:
-/// planes in closed form, the others as level sets (implicit shapes and surfaces voxelised at
-/// `voxel_size`, default half the mesh's mean edge length).
-std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
+}  // namespace
+
+namespace detail {
+
+std::vector<Obstacle> build_obstacles(const Scene& scene, double mean_edge) {
   std::vector<Obstacle> obstacles;
   if (scene.ground) {
     obstacles.push_back(plane_obstacle("ground", scene.ground->point, scene.ground->normal));
     obstacles.back().friction = scene.ground->friction;
   }
-  const double mean_edge = mean_edge_length(mesh.vertices, mesh.tets);
   for (const ObstacleSpec& spec : scene.obstacles) {
     Obstacle obstacle;
     LevelSetOptions options;
@@ -76,6 +76,14 @@ std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
     obstacles.push_back(std::move(obstacle));
   }
   return obstacles;
+}
+
+}  // namespace detail
+
+namespace {
+
+std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
+  return detail::build_obstacles(scene, mean_edge_length(mesh.vertices, mesh.tets));
 }
 
 /// The scene's run (SimulationRun): a plain Simulation on the mesh, or (scene key "hierarchy") an

@@ -72,9 +72,18 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     SpringBody body =
         skeleton_spring_body(surface.vertices, surface.triangles, skeleton.points, segments,
                              skeleton.owner, scene.material, scene.body.rule, "body");
+    double edges = 0.0;
+    for (Index f = 0; f < surface.triangles.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        edges += (surface.vertices.row(surface.triangles(f, k)) -
+                  surface.vertices.row(surface.triangles(f, (k + 1) % 3)))
+                     .norm();
+    std::vector<Obstacle> obstacles = build_obstacles(
+        scene, edges / (3.0 * static_cast<double>(std::max<Index>(surface.triangles.rows(), 1))));
     run = std::make_unique<SpringBodySimulation>(std::move(body), scene.material,
                                                  scene.dirichlet_groups(), scene.forces,
-                                                 scene.ground, scene.gravity, scene.solver);
+                                                 std::nullopt, scene.gravity, scene.solver,
+                                                 std::move(obstacles));
   } catch (const InputError& error) {
     throw InputError(scene.file.string() + ": " + error.what());
   }
@@ -197,6 +206,16 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
                          {"kinetic", run->kinetic_energy()},
                          {"external_potential", run->external_potential_energy()}};
     stats["max_displacement"] = max_displacement;
+    if (run->has_obstacles()) {
+      const ContactSettings& contact = run->contact_settings();
+      stats["contact"] = {{"max_penetration", run->max_penetration()},
+                          {"tolerance", contact.distance},
+                          {"barrier_stiffness", contact.stiffness},
+                          {"friction_slip", contact.friction_slip},
+                          {"points", S},
+                          {"surface_points", S},
+                          {"active_contacts", run->contact_counts()}};
+    }
     stats["probes"] = scene.output.probes.size();
     write_file_atomically(summary.output_dir / "stats.json",
                           [&stats](std::ostream& out) { out << stats.dump(2) << '\n'; });

@@ -79,8 +79,11 @@ SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i>
 
 /// Runs a SpringBody with the dynamic integrators (implicit Euler by Newton on the incremental
 /// potential, symplectic Euler, RK4), gravity, region loads (on the surface triangles), Dirichlet
-/// groups (any body vertex in the region), Rayleigh mass damping α and the ground (projection
-/// after each step, as for tet meshes). An implicit step whose Newton solve fails is retried from
+/// groups (any body vertex in the region), Rayleigh mass damping α, the ground (projection after
+/// each step, as core's GroundPlane) and obstacles: the surface vertices contact them as a tet
+/// mesh's boundary vertices do (energy/contact_term.hpp: the barrier and lagged friction in
+/// implicit steps, d̂ = solver.contact_distance or 1e-3 × the bounding-box diagonal, κ = E × the
+/// mean surface edge length; the projection after explicit steps). An implicit step whose Newton solve fails is retried from
 /// its start as 2, 4, 8 or 16 substeps (outputs stay on the scene's time grid). Static mode and
 /// stiffness damping are not offered: a spring body has floppy modes no static solve can pin down.
 class SpringBodySimulation {
@@ -90,7 +93,7 @@ class SpringBodySimulation {
                        const std::vector<DirichletSpec>& dirichlet,
                        const std::vector<RegionLoad>& loads,
                        const std::optional<GroundPlane>& ground, const Vector3d& gravity,
-                       const SolverSettings& settings);
+                       const SolverSettings& settings, std::vector<Obstacle> obstacles = {});
 
   /// One time step. Throws DivergenceError naming the step for a non-finite state or a failed
   /// Newton solve.
@@ -116,6 +119,12 @@ class SpringBodySimulation {
   /// prescribed DOFs (f: springs, loads and damping now; the prescribed acceleration of a linear
   /// ramp is zero), and its moment about the group's moment center.
   std::vector<GroupReaction> reactions() const;
+  /// Obstacles: the contact settings, the largest depth of a surface vertex inside an obstacle
+  /// after any step [m], and the vertex–obstacle pairs in contact after each step.
+  bool has_obstacles() const { return !m_obstacles.empty(); }
+  const ContactSettings& contact_settings() const { return m_contact_settings; }
+  double max_penetration() const { return m_max_penetration; }
+  const std::vector<Index>& contact_counts() const { return m_contact_counts; }
 
  private:
   VectorXd forces(const VectorXd& x, const VectorXd& v, double t) const;
@@ -144,6 +153,12 @@ class SpringBodySimulation {
   /// factorisation is done once.
   std::unique_ptr<DofReduction> m_reduction;
   std::unique_ptr<SpdSolver> m_solver;
+  std::vector<Obstacle> m_obstacles;
+  std::vector<int> m_surface_points;  ///< the contact points: surface vertices 0..#S−1
+  ContactSettings m_contact_settings;
+  std::unique_ptr<ContactTerm> m_contact;  ///< on the surface vertices, lagged at the last step
+  double m_max_penetration = 0.0;
+  std::vector<Index> m_contact_counts;
 };
 
 }  // namespace strata
