@@ -212,8 +212,22 @@ def load_spec(path, quick=False):
     return spec
 
 
+def has_fine_surface(spec):
+    """Whether the spec's scene simulates a fine surface (mesh.surface): its runs then write the
+    surface frames (output.vtk "surface") for the fine-surface error."""
+    return "surface" in json.loads(spec["scene_bytes"]).get("mesh", {})
+
+
 def planned_runs(spec):
     """(name, kind, settings) of every run of the sweep, the reference first."""
+    runs = planned_runs_of(spec)
+    if has_fine_surface(spec):
+        for _, _, settings in runs:
+            settings["output.vtk"] = "surface"
+    return runs
+
+
+def planned_runs_of(spec):
     runs = [("full", "full", {"hierarchy.mode": "full"})]
     for level in spec["uniform_levels"]:
         runs.append((f"uniform-{level}", "uniform",
@@ -494,12 +508,14 @@ def summarise(args, spec):
                 "redone_steps": hierarchy.get("redone_steps", 0),
                 "estimated_error": hierarchy.get("estimated_error"),
                 "tolerance_met": hierarchy.get("tolerance_met"),
+                "recorded_tolerance": hierarchy.get("precomputed", {}).get("recorded_tolerance"),
                 "final_energies": stats.get("energies"),
                 "history": {k: history.get(k, []) for k in ("time", "tets", "dofs",
                                                              "estimated_error")},
             })
         has_probes = os.path.exists(os.path.join(folder, "probes.csv"))
         row["probes"] = read_probes(folder) if has_probes else {}
+        row["surface_frames"] = surface_frames(folder)
         if name == "full" and row["status"] == "ok":
             reference = row["probes"]
         rows.append(row)
@@ -510,6 +526,11 @@ def summarise(args, spec):
         row["error_over_time"] = sorted(per_time.items())
         del row["probes"]
     full = next((r for r in rows if r["run"] == "full"), None)
+    if full is not None and full["surface_frames"]:
+        for row in rows:
+            row["surface_error"] = surface_error(full["surface_frames"], row["surface_frames"])
+    for row in rows:
+        del row["surface_frames"]
     for row in rows:
         # Final elastic, kinetic and external-potential energies against the full run's, relative
         # to the full run's largest of the three.
@@ -526,8 +547,52 @@ def summarise(args, spec):
     return rows
 
 
+def surface_frames(folder):
+    """The fine surface's .vtp frames of a run in frame order: `*_surface_NNNNNN.vtp` of a tet
+    run, else the surface frames `*_NNNNNN.vtp` of a skeleton-spring body (not its skeleton)."""
+    if not os.path.isdir(folder):
+        return []
+    names = sorted(os.listdir(folder))
+    frames = [f for f in names if re.fullmatch(r".*_surface_\d{6}\.vtp", f)]
+    if not frames:
+        frames = [f for f in names if re.fullmatch(r".*_\d{6}\.vtp", f) and "_skeleton_" not in f]
+    return [os.path.join(folder, f) for f in frames]
+
+
+def vtp_points(path):
+    """The points (n × 3) of an ASCII .vtp frame written by strata."""
+    with open(path) as f:
+        text = f.read()
+    match = re.search(r"<Points>\s*<DataArray[^>]*>([^<]*)</DataArray>", text)
+    if match is None:
+        raise ValueError(f"{path}: no Points")
+    values = [float(v) for v in match.group(1).split()]
+    return [values[i:i + 3] for i in range(0, len(values), 3)]
+
+
+def surface_error(reference, frames):
+    """The largest RMS distance between the run's fine surface and the full run's over the
+    frames, relative to the bounding-box diagonal of the full run's first frame; None when the
+    frames do not match."""
+    if len(frames) != len(reference) or not frames:
+        return None
+    worst, diagonal = 0.0, None
+    for mine, theirs in zip(frames, reference):
+        a, b = vtp_points(mine), vtp_points(theirs)
+        if len(a) != len(b) or not a:
+            return None
+        if diagonal is None:
+            lo = [min(p[k] for p in b) for k in range(3)]
+            hi = [max(p[k] for p in b) for k in range(3)]
+            diagonal = sum((h - l) ** 2 for h, l in zip(hi, lo)) ** 0.5
+        squares = sum((p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2
+                      for p, q in zip(a, b))
+        worst = max(worst, (squares / len(a)) ** 0.5)
+    return worst / diagonal if diagonal else None
+
+
 COLUMNS = ["run", "kind", "level", "tolerance", "variant", "windows", "training_seconds", "status",
-           "error", "energy_difference",
+           "error", "surface_error", "energy_difference",
            "estimated_error",
            "effectivity", "tolerance_met", "wall_seconds", "cpu_seconds", "speedup",
            "max_active_tets", "max_dofs", "element_evaluations", "newton_iterations",

@@ -181,11 +181,11 @@ TEST(SkeletonSprings, ABeamDroppedOnAPlaneRestsOnItWithinTheTolerance) {
   EXPECT_LT(lowest, 0.005);  // on the plane, not above it
   EXPECT_LT(run.kinetic_energy(), 1e-6 * run.body().vertex_mass.sum() * 9.81 * 0.02);
   // A body that starts inside an obstacle is an error naming it.
-  EXPECT_THROW(SpringBodySimulation(body_of(surface, curve_skeleton(surface, "beam")), material,
-                                    {}, {}, std::nullopt, Vector3d::Zero(), settings,
-                                    {plane_obstacle("floor", Vector3d(0, 0, 0.05),
-                                                    Vector3d::UnitZ())}),
-               InputError);
+  EXPECT_THROW(
+      SpringBodySimulation(body_of(surface, curve_skeleton(surface, "beam")), material, {}, {},
+                           std::nullopt, Vector3d::Zero(), settings,
+                           {plane_obstacle("floor", Vector3d(0, 0, 0.05), Vector3d::UnitZ())}),
+      InputError);
 }
 
 TEST(SkeletonSprings, ACantileverBendsWithTheStiffnessTheRulePredicts) {

@@ -313,7 +313,15 @@ OutputSpec parse_output(const SceneValue& value) {
       output.probes.push_back(probe.vec3());
     }
   }
-  if (value.has("vtk")) output.vtk = value.at("vtk").boolean();
+  if (value.has("vtk")) {
+    const SceneValue vtk = value.at("vtk");
+    if (vtk.json().is_string()) {
+      vtk.choice({"surface"});
+      output.vtk_mesh = false;
+    } else {
+      output.vtk = vtk.boolean();
+    }
+  }
   return output;
 }
 

@@ -80,10 +80,9 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
                      .norm();
     std::vector<Obstacle> obstacles = build_obstacles(
         scene, edges / (3.0 * static_cast<double>(std::max<Index>(surface.triangles.rows(), 1))));
-    run = std::make_unique<SpringBodySimulation>(std::move(body), scene.material,
-                                                 scene.dirichlet_groups(), scene.forces,
-                                                 std::nullopt, scene.gravity, scene.solver,
-                                                 std::move(obstacles));
+    run = std::make_unique<SpringBodySimulation>(
+        std::move(body), scene.material, scene.dirichlet_groups(), scene.forces, std::nullopt,
+        scene.gravity, scene.solver, std::move(obstacles));
   } catch (const InputError& error) {
     throw InputError(scene.file.string() + ": " + error.what());
   }

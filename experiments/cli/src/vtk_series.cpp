@@ -27,10 +27,17 @@ std::filesystem::path prepare_series(const std::filesystem::path& folder, const 
 
 }  // namespace
 
-VtkSeries::VtkSeries(const std::filesystem::path& folder, const std::string& stem)
-    : m_folder(folder), m_stem(stem), m_pvd(prepare_series(folder, stem)) {}
+VtkSeries::VtkSeries(const std::filesystem::path& folder, const std::string& stem, bool mesh_frames)
+    : m_folder(folder),
+      m_stem(stem),
+      m_pvd(prepare_series(folder, stem)),
+      m_mesh_frames(mesh_frames) {}
 
 void VtkSeries::write_frame(double time, const Simulation& simulation, const VectorXi* levels) {
+  if (!m_mesh_frames) {
+    ++m_frames;  // numbers the surface frames
+    return;
+  }
   const TetMesh& mesh = simulation.mesh();
   const MatrixX3d positions = unflatten(simulation.positions());
   const TetFields tet_fields = simulation.model().tet_fields(simulation.positions());

@@ -83,9 +83,10 @@ SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i>
 /// each step, as core's GroundPlane) and obstacles: the surface vertices contact them as a tet
 /// mesh's boundary vertices do (energy/contact_term.hpp: the barrier and lagged friction in
 /// implicit steps, d̂ = solver.contact_distance or 1e-3 × the bounding-box diagonal, κ = E × the
-/// mean surface edge length; the projection after explicit steps). An implicit step whose Newton solve fails is retried from
-/// its start as 2, 4, 8 or 16 substeps (outputs stay on the scene's time grid). Static mode and
-/// stiffness damping are not offered: a spring body has floppy modes no static solve can pin down.
+/// mean surface edge length; the projection after explicit steps). An implicit step whose Newton
+/// solve fails is retried from its start as 2, 4, 8 or 16 substeps (outputs stay on the scene's
+/// time grid). Static mode and stiffness damping are not offered: a spring body has floppy modes no
+/// static solve can pin down.
 class SpringBodySimulation {
  public:
   /// Throws InputError for static mode, stiffness damping, invalid regions or loads.

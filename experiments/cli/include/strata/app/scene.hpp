@@ -68,6 +68,9 @@ struct OutputSpec {
   int every = 1;                 ///< write a frame every this many steps (and after the last)
   std::vector<Vector3d> probes;  ///< rest positions of tracked material points [m]
   bool vtk = true;               ///< write <stem>.pvd + one .vtu per frame
+  /// With vtk: the simulation mesh's .vtu frames too; false ("vtk": "surface"): only the bound
+  /// fine surface's .vtp frames.
+  bool vtk_mesh = true;
 };
 
 /// A whole scene. Dirichlet groups are named by their key paths ("fixed.0", "prescribed.1"),

@@ -18,7 +18,8 @@ namespace strata::app {
 class VtkSeries {
  public:
   /// Removes frames `<stem>_NNNNNN.vtu` of an older run in `folder` and starts an empty .pvd.
-  VtkSeries(const std::filesystem::path& folder, const std::string& stem);
+  /// `mesh_frames` false: write_frame writes no .vtu (only the surface frames are kept).
+  VtkSeries(const std::filesystem::path& folder, const std::string& stem, bool mesh_frames = true);
 
   /// Writes the simulation's current state as the next frame at `time` (load factor when static).
   /// `levels` (#T, optional): the tree level of each cell (active cut of a hierarchy); 0 without.
@@ -37,6 +38,7 @@ class VtkSeries {
   std::string m_stem;
   PvdWriter m_pvd;
   int m_frames = 0;
+  bool m_mesh_frames = true;
 };
 
 }  // namespace strata::app
