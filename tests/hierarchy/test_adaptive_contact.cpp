@@ -218,7 +218,9 @@ TEST(AdaptiveContact, PushOutMovesAnInfeasibleStateToTheSurface) {
   for (Index v = 0; v < mesh.vertices.rows(); ++v) {
     const double z = sim.positions()[3 * v + 2];
     EXPECT_GE(z, -0.5e-3);
-    if (mesh.vertices(v, 2) > 0.0) EXPECT_EQ(z, mesh.vertices(v, 2));
+    if (mesh.vertices(v, 2) > 0.0) {
+      EXPECT_EQ(z, mesh.vertices(v, 2));
+    }
   }
   EXPECT_EQ(sim.push_out_of_obstacles(), 0.0);  // feasible now
   sim.advance();                                // and the barrier accepts it

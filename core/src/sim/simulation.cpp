@@ -186,17 +186,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   if (m_contact && m_first_step == 0) {
     const double t = is_static() ? 0.0 : time();
     m_contact->set_step(m_x, t, t);
-    for (const Obstacle& obstacle : m_obstacles)
-      for (Index p = 0; p < m_contact->num_points(); ++p) {
-        Vector3d gradient;
-        const double phi = obstacle.distance_at(m_contact->position(m_x, p), t, gradient);
-        if (!(phi > -contact.distance))
-          throw InputError(obstacle.name + ": contact point " + std::to_string(p) + " starts " +
-                           format_number(-phi) +
-                           " m inside the obstacle (more than the contact "
-                           "tolerance " +
-                           format_number(contact.distance) + " m)");
-      }
+    m_contact->require_feasible(m_x, "contact point");
   }
 }
 

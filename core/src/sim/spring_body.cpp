@@ -277,13 +277,7 @@ SpringBodySimulation::SpringBodySimulation(SpringBody body, const Material& mate
       validate_obstacle(obstacle);
     const double diagonal =
         (m_body.rest.colwise().maxCoeff() - m_body.rest.colwise().minCoeff()).norm();
-    double edges = 0.0;
-    for (Index f = 0; f < m_body.triangles.rows(); ++f)
-      for (int k = 0; k < 3; ++k)
-        edges += (m_body.rest.row(m_body.triangles(f, k)) -
-                  m_body.rest.row(m_body.triangles(f, (k + 1) % 3)))
-                     .norm();
-    const double mean_edge = edges / (3.0 * static_cast<double>(m_body.triangles.rows()));
+    const double mean_edge = mean_triangle_edge_length(m_body.rest, m_body.triangles);
     m_contact_settings.distance =
         m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * diagonal;
     m_contact_settings.stiffness = m_material.youngs_modulus * mean_edge;
@@ -295,16 +289,7 @@ SpringBodySimulation::SpringBodySimulation(SpringBody body, const Material& mate
       m_surface_points[i] = static_cast<int>(i);
     m_contact = std::make_unique<ContactTerm>(m_obstacles, m_surface_points, m_contact_settings);
     m_contact->set_step(m_x, 0.0, 0.0);
-    for (const Obstacle& obstacle : m_obstacles)
-      for (Index p = 0; p < m_contact->num_points(); ++p) {
-        Vector3d gradient;
-        const double phi = obstacle.distance_at(m_contact->position(m_x, p), 0.0, gradient);
-        if (!(phi > -m_contact_settings.distance))
-          throw InputError(obstacle.name + ": surface vertex " + std::to_string(p) + " starts " +
-                           std::to_string(-phi) +
-                           " m inside the obstacle (more than the contact tolerance " +
-                           std::to_string(m_contact_settings.distance) + " m)");
-      }
+    m_contact->require_feasible(m_x, "surface vertex");
   }
 }
 

@@ -49,4 +49,12 @@ double mean_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets)
   return tets.rows() > 0 ? sum / (6.0 * static_cast<double>(tets.rows())) : 0.0;
 }
 
+double mean_triangle_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX3i> triangles) {
+  double sum = 0.0;
+  for (Index f = 0; f < triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      sum += (positions.row(triangles(f, k)) - positions.row(triangles(f, (k + 1) % 3))).norm();
+  return triangles.rows() > 0 ? sum / (3.0 * static_cast<double>(triangles.rows())) : 0.0;
+}
+
 }  // namespace strata

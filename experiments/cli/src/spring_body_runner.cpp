@@ -15,6 +15,7 @@
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/io/pvd.hpp"
 #include "strata/core/io/vtp.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
 #include "strata/meshing/curve_skeleton.hpp"
 #include "strata/meshing/surface_io.hpp"
 
@@ -72,14 +73,8 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     SpringBody body =
         skeleton_spring_body(surface.vertices, surface.triangles, skeleton.points, segments,
                              skeleton.owner, scene.material, scene.body.rule, "body");
-    double edges = 0.0;
-    for (Index f = 0; f < surface.triangles.rows(); ++f)
-      for (int k = 0; k < 3; ++k)
-        edges += (surface.vertices.row(surface.triangles(f, k)) -
-                  surface.vertices.row(surface.triangles(f, (k + 1) % 3)))
-                     .norm();
-    std::vector<Obstacle> obstacles = build_obstacles(
-        scene, edges / (3.0 * static_cast<double>(std::max<Index>(surface.triangles.rows(), 1))));
+    std::vector<Obstacle> obstacles =
+        build_obstacles(scene, mean_triangle_edge_length(surface.vertices, surface.triangles));
     run = std::make_unique<SpringBodySimulation>(
         std::move(body), scene.material, scene.dirichlet_groups(), scene.forces, std::nullopt,
         scene.gravity, scene.solver, std::move(obstacles));

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "strata/core/common/error.hpp"
 
@@ -220,6 +222,23 @@ Index ContactTerm::add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const {
       ++active;
     }
   return active;
+}
+
+void ContactTerm::require_feasible(ConstRef<VectorXd> q, const std::string& point_name) const {
+  const auto format = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", value);
+    return std::string(text);
+  };
+  for (const Obstacle& obstacle : m_obstacles)
+    for (Index p = 0; p < num_points(); ++p) {
+      Vector3d gradient;
+      const double phi = obstacle.distance_at(position(q, p), m_time, gradient);
+      if (!(phi > -m_settings.distance))
+        throw InputError(obstacle.name + ": " + point_name + " " + std::to_string(p) + " starts " +
+                         format(-phi) + " m inside the obstacle (more than the contact tolerance " +
+                         format(m_settings.distance) + " m)");
+    }
 }
 
 double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained,

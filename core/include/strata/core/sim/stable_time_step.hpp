@@ -33,4 +33,8 @@ double stable_time_step_estimate(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
 /// Mean edge length over the tets' six edges [m] (edges shared by tets counted per tet).
 double mean_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets);
 
+/// Mean edge length over the triangles' three edges [m] (edges shared by triangles counted per
+/// triangle); 0 without triangles.
+double mean_triangle_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX3i> triangles);
+
 }  // namespace strata

@@ -18,6 +18,7 @@
 /// the potential μ λ f₀(‖u‖), f₀(y) = y²/ε − y³/(3ε²) + ε/3 below the slip tolerance ε and y above
 /// it: full Coulomb force μλ once the slip exceeds ε, a stiff spring below (static friction, with
 /// a creep of at most ε per step).
+#include <string>
 #include <vector>
 
 #include "strata/core/sim/energy/energy_term.hpp"
@@ -75,6 +76,10 @@ class ContactTerm final : public EnergyTerm {
   /// (0 when q was feasible). For a start that the barrier's domain excludes: an obstacle that
   /// moved into the body within a step, or a state carried over from another mesh.
   double push_out(VectorXd& q, const std::vector<char>& constrained, double depth) const;
+  /// Throws InputError "<obstacle>: <point_name> p starts D m inside the obstacle (more than the
+  /// contact tolerance d̂ m)" for the first point deeper than d̂ at the end-of-step placement: a
+  /// start the barrier cannot take.
+  void require_feasible(ConstRef<VectorXd> q, const std::string& point_name) const;
   /// The contact force on each point (num_points() entries, summed over the obstacles; zero
   /// where none acts): the barrier's, and with `friction` the lagged friction's too.
   std::vector<Vector3d> point_forces(ConstRef<VectorXd> q, bool friction) const;
