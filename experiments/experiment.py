@@ -66,6 +66,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(REPO, "experiments", "hierarchy"))
 from compare_to_full import read_probes  # noqa: E402  (probes.csv keyed by (time, probe))
+sys.path.insert(0, HERE)
+import vtk_xml  # noqa: E402  (strata's .vtu/.vtp frames)
 
 
 def fail(message):
@@ -560,14 +562,8 @@ def surface_frames(folder):
 
 
 def vtp_points(path):
-    """The points (n × 3) of an ASCII .vtp frame written by strata."""
-    with open(path) as f:
-        text = f.read()
-    match = re.search(r"<Points>\s*<DataArray[^>]*>([^<]*)</DataArray>", text)
-    if match is None:
-        raise ValueError(f"{path}: no Points")
-    values = [float(v) for v in match.group(1).split()]
-    return [values[i:i + 3] for i in range(0, len(values), 3)]
+    """The points (n × 3) of a .vtp frame written by strata (binary or ASCII)."""
+    return vtk_xml.read(path).points
 
 
 def surface_error(reference, frames):

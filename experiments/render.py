@@ -15,12 +15,15 @@ the same way (point fields are averaged per triangle). Fields: any cell field of
 `green_strain` (the first Voigt component) — or a point field (`displacement` magnitude).
 Continuous fields are coloured up to their 99th percentile over the frames (the rest in the top
 colour). `--up` names the model's vertical axis (default z; y for models such as the armadillo scan).
-Needs /usr/bin/python3 (matplotlib, meshio, numpy; Pillow for --gif).
+Needs /usr/bin/python3 (matplotlib, numpy; Pillow for --gif); frames are read by vtk_xml.py.
 """
 import argparse
 import os
 import sys
 import xml.etree.ElementTree as ElementTree
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import vtk_xml  # noqa: E402  (strata's .vtu/.vtp frames, binary or ASCII)
 
 import numpy as np
 
@@ -29,13 +32,38 @@ def fail(message):
     sys.exit(f"render: {message}")
 
 
+class Cells:
+    """One block of cells of a frame: `type` "tetra" or "triangle", `data` #cells × nodes."""
+
+    def __init__(self, kind, data):
+        self.type, self.data = kind, data
+
+
+class Mesh:
+    """A frame read by vtk_xml, with numpy arrays: points, cells, point_data, cell_data (one
+    array per block)."""
+
+    def __init__(self, frame):
+        self.points = np.asarray(frame.points, dtype=float).reshape(-1, 3)
+        self.cells = []
+        if frame.type == "UnstructuredGrid":
+            connectivity = np.asarray(frame.cells.get("Cells/connectivity", []), dtype=int)
+            types = np.asarray(frame.cells.get("Cells/types", []), dtype=int)
+            if len(types) and (types == 10).all() and len(connectivity) == 4 * len(types):
+                self.cells.append(Cells("tetra", connectivity.reshape(-1, 4)))
+        else:
+            connectivity = np.asarray(frame.cells.get("Polys/connectivity", []), dtype=int)
+            if len(connectivity) % 3 == 0 and len(connectivity):
+                self.cells.append(Cells("triangle", connectivity.reshape(-1, 3)))
+        self.point_data = {k: np.asarray(v, dtype=float) for k, v in frame.point_data.items()}
+        self.cell_data = {k: [np.asarray(v, dtype=float)] for k, v in frame.cell_data.items()}
+
+
 def load(path):
-    import meshio
     try:
-        mesh = meshio.read(path)
-    except Exception as error:  # meshio raises many types for malformed files
+        return Mesh(vtk_xml.read(path))
+    except (OSError, ValueError) as error:
         fail(f"{path}: cannot read ({error})")
-    return mesh
 
 
 def boundary(mesh):

@@ -9,6 +9,7 @@
 
 #include "cli_test_utils.hpp"
 #include "strata/core/common/types.hpp"
+#include "strata/core/io/vtu.hpp"
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 
@@ -67,21 +68,9 @@ inline std::string bar_off(MatrixX3d& vertices) {
   return off.str();
 }
 
-/// The numbers of the <Points> DataArray of a .vtp (ASCII, as strata writes it).
+/// The points of a .vtp frame written by strata (either encoding).
 inline MatrixX3d read_vtp_points(const std::filesystem::path& path) {
-  const std::string text = read_text(path);
-  const std::size_t points = text.find("<Points>");
-  const std::size_t begin = text.find('>', text.find("<DataArray", points)) + 1;
-  const std::size_t end = text.find("</DataArray>", begin);
-  std::istringstream numbers(text.substr(begin, end - begin));
-  std::vector<double> values;
-  double value;
-  while (numbers >> value)
-    values.push_back(value);
-  MatrixX3d result(static_cast<Index>(values.size() / 3), 3);
-  for (std::size_t k = 0; k < values.size(); ++k)
-    result(static_cast<Index>(k / 3), static_cast<Index>(k % 3)) = values[k];
-  return result;
+  return read_vtk_frame(path).points;
 }
 
 /// Checks a deformed surface frame against the volume frame it belongs to: every surface vertex

@@ -40,7 +40,7 @@ json slab_scene(const std::string& mode) {
 struct SlabRun {
   double probe_uz = 0.0;
   json stats;
-  std::string last_vtu;
+  std::filesystem::path last_vtu;
 };
 
 SlabRun run_slab(const TempFolder& folder, const std::string& mode) {
@@ -53,24 +53,14 @@ SlabRun run_slab(const TempFolder& folder, const std::string& mode) {
   EXPECT_EQ(probes.rows.size(), 6u);  // 3 frames × 2 probes
   if (probes.rows.size() >= 2) run.probe_uz = probes.rows[probes.rows.size() - 2][7];
   run.stats = read_json(out / "stats.json");
-  run.last_vtu = read_text(out / (mode + "_000002.vtu"));
+  run.last_vtu = out / (mode + "_000002.vtu");
   return run;
 }
 
-/// The per-cell "level" values of a .vtu written by strata (ASCII data arrays). Plain string
-/// search: std::regex recurses per character and overflows the stack on long arrays.
-std::vector<int> cell_levels(const std::string& vtu) {
-  std::vector<int> levels;
-  const std::size_t name = vtu.find("Name=\"level\"");
-  if (name == std::string::npos) return levels;
-  const std::size_t begin = vtu.find('>', name);
-  const std::size_t end = vtu.find("</DataArray>", begin);
-  if (begin == std::string::npos || end == std::string::npos) return levels;
-  std::stringstream values(vtu.substr(begin + 1, end - begin - 1));
-  int level;
-  while (values >> level)
-    levels.push_back(level);
-  return levels;
+/// The per-cell "level" values of a .vtu written by strata.
+std::vector<int> cell_levels(const std::filesystem::path& vtu) {
+  const Eigen::MatrixXd level = read_vtk_frame(vtu).cell_field("level");
+  return std::vector<int>(level.data(), level.data() + level.size());
 }
 
 TEST(CliHierarchy, AdaptiveRunRefinesNearTheLoadAndMatchesFullResolution) {
@@ -171,7 +161,7 @@ TEST(CliHierarchy, FineSurfaceFollowsTheActiveCut) {
   const TetMesh rest = read_vtu(out / "scene_000000.vtu");
   const TetMesh deformed = read_vtu(out / "scene_000001.vtu");
   ASSERT_EQ(deformed.vertices.rows(), rest.vertices.rows());
-  EXPECT_EQ(cell_levels(read_text(out / "scene_000001.vtu")),
+  EXPECT_EQ(cell_levels(out / "scene_000001.vtu"),
             std::vector<int>(static_cast<size_t>(rest.tets.rows()), 1));
   const MatrixX3d surface0 = read_vtp_points(out / "scene_surface_000000.vtp");
   ASSERT_EQ(surface0.rows(), surface.rows());

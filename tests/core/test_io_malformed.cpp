@@ -11,6 +11,7 @@
 #include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
+#include "strata/core/io/vtu.hpp"
 #include "strata/core/io/tetgen.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 
@@ -120,10 +121,29 @@ TEST(IoMalformed, SpecificErrors) {
                                    "format=\"ascii\">0 1 two 3</DataArray>" +
                                    vtu_tail);
   expect_input_error(dir / "word.vtu", "'two' is not a number");
-  write_text(dir / "appended.vtu",
-             "<VTKFile type=\"UnstructuredGrid\"><AppendedData encoding=\"raw\">_xx</AppendedData>"
-             "</VTKFile>");
-  expect_input_error(dir / "appended.vtu", "appended");
+  const std::string appended_head =
+      "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"4\" "
+      "NumberOfCells=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+      "format=\"appended\" offset=\"";
+  write_text(dir / "far.vtu", appended_head +
+                                  "99\"/></Points></Piece></UnstructuredGrid>"
+                                  "<AppendedData encoding=\"raw\">_xx</AppendedData></VTKFile>");
+  expect_input_error(dir / "far.vtu", "starts past the end of the file");
+  write_text(dir / "short.vtu", appended_head +
+                                    "0\"/></Points></Piece></UnstructuredGrid>"
+                                    "<AppendedData encoding=\"raw\">_xx</AppendedData></VTKFile>");
+  expect_input_error(dir / "short.vtu", "which the data does not hold");
+  write_text(dir / "b64.vtu",
+             appended_head +
+                 "0\"/></Points></Piece></UnstructuredGrid>"
+                 "<AppendedData encoding=\"base64\">_AAAA</AppendedData></VTKFile>");
+  expect_input_error(dir / "b64.vtu", "encoding 'base64' is not supported");
+  write_text(dir / "no_block.vtu",
+             appended_head + "0\"/></Points></Piece></UnstructuredGrid></VTKFile>");
+  expect_input_error(dir / "no_block.vtu", "has no <AppendedData>");
+  write_text(dir / "lzma.vtu",
+             "<VTKFile type=\"UnstructuredGrid\" compressor=\"vtkLZMADataCompressor\"></VTKFile>");
+  expect_input_error(dir / "lzma.vtu", "compressor 'vtkLZMADataCompressor' is not supported");
   write_text(dir / "poly.vtu", "<VTKFile type=\"PolyData\"></VTKFile>");
   expect_input_error(dir / "poly.vtu", "UnstructuredGrid");
 }
@@ -137,14 +157,16 @@ TEST(IoMalformed, TruncatedAndCorruptedFilesNeverCrash) {
   write_tet_mesh(dir / "source.msh", mesh);
   write_tet_mesh(dir / "source22.msh", mesh, {GmshVersion::v2_2});
   write_tet_mesh(dir / "source.mesh", mesh);
-  write_tet_mesh(dir / "source.vtu", mesh);
+  write_tet_mesh(dir / "source.vtu", mesh);  // binary: appended, zlib-compressed
+  write_vtu(dir / "source_ascii.vtu", mesh, VtkEncoding::ascii);
   write_tet_mesh(dir / "source.node", mesh);
   struct Case {
     std::string source, extension, sibling_extension;
   };
   const Case cases[] = {{"source.msh", ".msh", ""},       {"source22.msh", ".msh", ""},
                         {"source.mesh", ".mesh", ""},     {"source.vtu", ".vtu", ""},
-                        {"source.node", ".node", ".ele"}, {"source.ele", ".ele", ".node"}};
+                        {"source_ascii.vtu", ".vtu", ""}, {"source.node", ".node", ".ele"},
+                        {"source.ele", ".ele", ".node"}};
   std::mt19937 random(3);
   int counter = 0;
   for (const Case& test_case : cases) {

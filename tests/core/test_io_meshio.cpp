@@ -63,9 +63,12 @@ TEST(IoMeshio, MeshioReadsOurVtuMeditAndGmsh) {
   EXPECT_EQ(meshio_counts(dir / "box22.msh"), expected);
 }
 
-TEST(IoMeshio, MeshioSeesFrameFieldsWithTheirShapes) {
+class IoMeshioEncoding : public ::testing::TestWithParam<VtkEncoding> {};
+
+TEST_P(IoMeshioEncoding, MeshioSeesFrameFieldsWithTheirShapes) {
   if (!meshio_available()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
-  ScratchDir dir("io_meshio_fields");
+  ScratchDir dir(GetParam() == VtkEncoding::binary ? "io_meshio_binary_fields"
+                                                   : "io_meshio_ascii_fields");
   const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(1, 1, 1), {1, 2, 1});
   const Index nv = mesh.vertices.rows(), nt = mesh.tets.rows();
   VtuFields fields;
@@ -73,7 +76,7 @@ TEST(IoMeshio, MeshioSeesFrameFieldsWithTheirShapes) {
   fields.add_cell_data("stress", Eigen::MatrixXd::Ones(nt, 6));
   fields.add_cell_data("von_mises", Eigen::MatrixXd::Constant(nt, 1, 2.0));
   fields.add_cell_data("level", Eigen::MatrixXi::Constant(nt, 1, 3));
-  write_vtu(dir / "frame.vtu", mesh.vertices, mesh.tets, fields);
+  write_vtu(dir / "frame.vtu", mesh.vertices, mesh.tets, fields, GetParam());
   const std::string output =
       run_python("import meshio; m=meshio.read(\"" + (dir / "frame.vtu").string() +
                  "\"); d=m.point_data[\"displacement\"]; s=m.cell_data[\"stress\"][0]; "
@@ -84,21 +87,31 @@ TEST(IoMeshio, MeshioSeesFrameFieldsWithTheirShapes) {
                         std::to_string(3 * nt) + "\n");
 }
 
+INSTANTIATE_TEST_SUITE_P(Encodings, IoMeshioEncoding,
+                         ::testing::Values(VtkEncoding::binary, VtkEncoding::ascii),
+                         [](const ::testing::TestParamInfo<VtkEncoding>& info) {
+                           return info.param == VtkEncoding::binary ? "binary" : "ascii";
+                         });
+
 TEST(IoMeshio, ReadsMeshioBinaryVtu) {
   if (!meshio_available()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
   ScratchDir dir("io_meshio_binary");
   TetMesh mesh = box_tet_mesh(Vector3d(-1, 0.1, 0.3), Vector3d(1, 0.7, 2.9), {2, 2, 3});
-  write_vtu(dir / "ascii.vtu", mesh);
-  const std::string output =
-      run_python("import meshio; m=meshio.read(\"" + (dir / "ascii.vtu").string() +
-                 "\"); meshio.vtu.write(\"" + (dir / "binary.vtu").string() +
-                 "\", m, binary=True, compression=None); print(\"done\")");
-  ASSERT_EQ(output, "done\n");
-  const TetMesh back = read_tet_mesh(dir / "binary.vtu");
-  ASSERT_EQ(back.vertices.rows(), mesh.vertices.rows());
-  ASSERT_EQ(back.tets.rows(), mesh.tets.rows());
-  EXPECT_TRUE((back.vertices.array() == mesh.vertices.array()).all());
-  EXPECT_TRUE((back.tets.array() == mesh.tets.array()).all());
+  mesh.vertices(1, 0) = 1.0 / 3.0;
+  write_vtu(dir / "ascii.vtu", mesh, VtkEncoding::ascii);
+  for (const std::string compression : {"None", "\"zlib\""}) {
+    SCOPED_TRACE(compression);
+    const std::string output =
+        run_python("import meshio; m=meshio.read(\"" + (dir / "ascii.vtu").string() +
+                   "\"); meshio.vtu.write(\"" + (dir / "binary.vtu").string() +
+                   "\", m, binary=True, compression=" + compression + "); print(\"done\")");
+    ASSERT_EQ(output, "done\n");
+    const TetMesh back = read_tet_mesh(dir / "binary.vtu");
+    ASSERT_EQ(back.vertices.rows(), mesh.vertices.rows());
+    ASSERT_EQ(back.tets.rows(), mesh.tets.rows());
+    EXPECT_TRUE((back.vertices.array() == mesh.vertices.array()).all());
+    EXPECT_TRUE((back.tets.array() == mesh.tets.array()).all());
+  }
 }
 
 }  // namespace

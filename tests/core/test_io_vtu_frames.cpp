@@ -1,4 +1,5 @@
 // VTU frames with fields and ParaView .pvd series.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -49,6 +50,40 @@ TEST(IoVtuFrames, FrameWithFieldsReadsBackDeformedPositions) {
   EXPECT_EQ(count(text, "type=\"Float64\" Name=\"green_strain\" NumberOfComponents=\"6\""), 1);
   EXPECT_EQ(count(text, "type=\"Int32\" Name=\"level\" NumberOfComponents=\"1\""), 1);
   EXPECT_EQ(count(text, "Name=\"a&lt;b&amp;&quot;c&quot;\""), 1);
+}
+
+TEST(IoVtuFrames, BothEncodingsReadBackTheIdenticalArrays) {
+  ScratchDir dir("io_frame_encodings");
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {6, 5, 4});
+  const Index nv = mesh.vertices.rows(), nt = mesh.tets.rows();
+  const MatrixX3d positions = mesh.vertices + 1e-3 * MatrixX3d::Random(nv, 3);
+  VtuFields fields;
+  const Eigen::MatrixXd velocity = Eigen::MatrixXd::Random(nv, 3);
+  const Eigen::MatrixXd stress = 1e6 * Eigen::MatrixXd::Random(nt, 6);
+  const Eigen::MatrixXi level = Eigen::VectorXi::LinSpaced(nt, -3, 7);
+  fields.add_point_data("velocity", velocity);
+  fields.add_cell_data("stress", stress);
+  fields.add_cell_data("level", level);
+  write_vtu(dir / "binary.vtu", positions, mesh.tets, fields, VtkEncoding::binary);
+  write_vtu(dir / "ascii.vtu", positions, mesh.tets, fields, VtkEncoding::ascii);
+  for (const char* name : {"binary.vtu", "ascii.vtu"}) {
+    SCOPED_TRACE(name);
+    const VtkFrame frame = read_vtk_frame(dir / name);
+    EXPECT_EQ(frame.type, "UnstructuredGrid");
+    EXPECT_TRUE((frame.points.array() == positions.array()).all());
+    EXPECT_TRUE((frame.point_field("velocity").array() == velocity.array()).all());
+    EXPECT_TRUE((frame.cell_field("stress").array() == stress.array()).all());
+    EXPECT_TRUE((frame.cell_field("level").cast<int>().array() == level.array()).all());
+    ASSERT_EQ(frame.cells.size(), 3u);
+    EXPECT_EQ(frame.cells[0].first, "Cells/connectivity");
+    EXPECT_EQ(frame.cells[0].second.size(), static_cast<std::size_t>(4 * nt));
+    EXPECT_EQ(frame.cells[0].second[5], mesh.tets(1, 1));
+    EXPECT_THROW(frame.point_field("missing"), InputError);
+    const TetMesh back = read_vtu(dir / name);
+    EXPECT_TRUE((back.tets.array() == mesh.tets.array()).all());
+  }
+  EXPECT_THAT(read_text(dir / "binary.vtu"), ::testing::HasSubstr("vtkZLibDataCompressor"));
+  EXPECT_LT(fs::file_size(dir / "binary.vtu"), fs::file_size(dir / "ascii.vtu") / 2);
 }
 
 TEST(IoVtuFrames, FieldWithWrongRowCountIsInputErrorNamingIt) {

@@ -1,5 +1,11 @@
 #include "vtk_xml.hpp"
 
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstring>
+#include <type_traits>
+
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/number_text.hpp"
 
@@ -14,25 +20,6 @@ void check_rows(const std::filesystem::path& path, const std::string& kind, cons
                      "' has " + std::to_string(values.rows()) + " × " +
                      std::to_string(values.cols()) + " entries, expected " + std::to_string(rows) +
                      " rows");
-}
-
-template <typename Matrix>
-void write_array(std::ostream& out, const char* type, const std::string& name,
-                 const Matrix& values) {
-  out << "        <DataArray type=\"" << type << "\" Name=\"" << escape(name)
-      << "\" NumberOfComponents=\"" << values.cols() << "\" format=\"ascii\">\n";
-  for (Index r = 0; r < values.rows(); ++r) {
-    out << "         ";
-    for (Index c = 0; c < values.cols(); ++c) {
-      out << ' ';
-      if constexpr (std::is_integral_v<typename Matrix::Scalar>)
-        out << values(r, c);
-      else
-        write_double(out, values(r, c));
-    }
-    out << '\n';
-  }
-  out << "        </DataArray>\n";
 }
 
 }  // namespace
@@ -73,43 +60,134 @@ void check_field_rows(const std::filesystem::path& path, const VtuFields& fields
     check_rows(path, "cell", name, values, num_cells);
 }
 
-void write_data_array(std::ostream& out, const std::string& name, const Eigen::MatrixXd& values) {
-  write_array(out, "Float64", name, values);
+namespace {
+
+constexpr std::size_t kBlockSize = 1 << 16;  ///< uncompressed bytes per zlib block
+
+template <typename T>
+const char* type_name() {
+  if constexpr (std::is_same_v<T, double>)
+    return "Float64";
+  else if constexpr (std::is_same_v<T, std::int32_t>)
+    return "Int32";
+  else if constexpr (std::is_same_v<T, std::int64_t>)
+    return "Int64";
+  else {
+    static_assert(std::is_same_v<T, std::uint8_t>, "unsupported DataArray type");
+    return "UInt8";
+  }
 }
 
-void write_data_array(std::ostream& out, const std::string& name, const Eigen::MatrixXi& values) {
-  write_array(out, "Int32", name, values);
+void put_u64(std::vector<std::uint8_t>& bytes, std::size_t at, std::uint64_t value) {
+  std::memcpy(bytes.data() + at, &value, sizeof value);  // little endian, as byte_order says
 }
 
-void write_fields_and_points(std::ostream& out, const VtuFields& fields,
-                             ConstRef<MatrixX3d> positions) {
+/// The rows of a field matrix, row by row.
+template <typename Scalar, typename Matrix>
+std::vector<Scalar> row_major(const Matrix& values) {
+  std::vector<Scalar> flat;
+  flat.reserve(static_cast<std::size_t>(values.size()));
+  for (Index r = 0; r < values.rows(); ++r)
+    for (Index c = 0; c < values.cols(); ++c)
+      flat.push_back(static_cast<Scalar>(values(r, c)));
+  return flat;
+}
+
+}  // namespace
+
+void DataArrayWriter::begin_file(std::ostream& out, const char* type) const {
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"" << type
+      << "\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\""
+      << (m_encoding == VtkEncoding::binary ? " compressor=\"vtkZLibDataCompressor\"" : "")
+      << ">\n";
+}
+
+void DataArrayWriter::append_compressed(const std::uint8_t* data, std::size_t size) {
+  const std::size_t num_blocks = (size + kBlockSize - 1) / kBlockSize;
+  const std::size_t header_at = m_appended.size();
+  m_appended.resize(header_at + 8 * (3 + num_blocks));
+  put_u64(m_appended, header_at, num_blocks);
+  put_u64(m_appended, header_at + 8, kBlockSize);
+  put_u64(m_appended, header_at + 16, size % kBlockSize);  // 0: the last block is full
+  for (std::size_t b = 0; b < num_blocks; ++b) {
+    const std::size_t begin = b * kBlockSize;
+    const std::size_t length = std::min(kBlockSize, size - begin);
+    uLongf compressed = compressBound(static_cast<uLong>(length));
+    const std::size_t at = m_appended.size();
+    m_appended.resize(at + compressed);
+    if (compress2(m_appended.data() + at, &compressed, data + begin, static_cast<uLong>(length),
+                  Z_BEST_SPEED) != Z_OK)
+      throw std::runtime_error("zlib could not compress a VTK data block");
+    m_appended.resize(at + compressed);
+    put_u64(m_appended, header_at + 8 * (3 + b), compressed);
+  }
+}
+
+template <typename T>
+void DataArrayWriter::write(std::ostream& out, const std::string& name, int components,
+                            const std::vector<T>& values) {
+  out << "        <DataArray type=\"" << type_name<T>() << "\"";
+  if (!name.empty()) out << " Name=\"" << escape(name) << "\"";
+  out << " NumberOfComponents=\"" << components << "\"";
+  if (m_encoding == VtkEncoding::binary) {
+    out << " format=\"appended\" offset=\"" << m_appended.size() << "\"/>\n";
+    append_compressed(reinterpret_cast<const std::uint8_t*>(values.data()),
+                      values.size() * sizeof(T));
+    return;
+  }
+  out << " format=\"ascii\">\n";
+  const std::size_t per_line = components > 1 ? static_cast<std::size_t>(components) : 16;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    out << (i % per_line == 0 ? "          " : " ");
+    if constexpr (std::is_same_v<T, double>)
+      write_double(out, values[i]);
+    else
+      out << static_cast<long long>(values[i]);
+    if (i % per_line == per_line - 1 || i + 1 == values.size()) out << '\n';
+  }
+  out << "        </DataArray>\n";
+}
+
+template void DataArrayWriter::write(std::ostream&, const std::string&, int,
+                                     const std::vector<double>&);
+template void DataArrayWriter::write(std::ostream&, const std::string&, int,
+                                     const std::vector<std::int32_t>&);
+template void DataArrayWriter::write(std::ostream&, const std::string&, int,
+                                     const std::vector<std::int64_t>&);
+template void DataArrayWriter::write(std::ostream&, const std::string&, int,
+                                     const std::vector<std::uint8_t>&);
+
+void DataArrayWriter::write_fields_and_points(std::ostream& out, const VtuFields& fields,
+                                              ConstRef<MatrixX3d> positions) {
   if (!fields.point_data.empty() || !fields.point_int_data.empty()) {
     out << "      <PointData>\n";
     for (const auto& [name, values] : fields.point_data)
-      write_data_array(out, name, values);
+      write(out, name, static_cast<int>(values.cols()), row_major<double>(values));
     for (const auto& [name, values] : fields.point_int_data)
-      write_data_array(out, name, values);
+      write(out, name, static_cast<int>(values.cols()), row_major<std::int32_t>(values));
     out << "      </PointData>\n";
   }
   if (!fields.cell_data.empty() || !fields.cell_int_data.empty()) {
     out << "      <CellData>\n";
     for (const auto& [name, values] : fields.cell_data)
-      write_data_array(out, name, values);
+      write(out, name, static_cast<int>(values.cols()), row_major<double>(values));
     for (const auto& [name, values] : fields.cell_int_data)
-      write_data_array(out, name, values);
+      write(out, name, static_cast<int>(values.cols()), row_major<std::int32_t>(values));
     out << "      </CellData>\n";
   }
-  out << "      <Points>\n"
-         "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (Index v = 0; v < positions.rows(); ++v) {
-    out << "         ";
-    for (int d = 0; d < 3; ++d) {
-      out << ' ';
-      write_double(out, positions(v, d));
-    }
-    out << '\n';
+  out << "      <Points>\n";
+  write(out, "", 3, row_major<double>(positions));
+  out << "      </Points>\n";
+}
+
+void DataArrayWriter::end_file(std::ostream& out) const {
+  if (m_encoding == VtkEncoding::binary) {
+    out << "  <AppendedData encoding=\"raw\">\n   _";
+    out.write(reinterpret_cast<const char*>(m_appended.data()),
+              static_cast<std::streamsize>(m_appended.size()));
+    out << "\n  </AppendedData>\n";
   }
-  out << "        </DataArray>\n      </Points>\n";
+  out << "</VTKFile>\n";
 }
 
 }  // namespace strata::vtk_xml

@@ -1,9 +1,11 @@
 #pragma once
-// Internal helpers shared by the VTK XML writers (.vtu, .vtp, .pvd): escaping, field checks and
-// ASCII DataArrays. Not installed.
+// Internal helpers shared by the VTK XML writers (.vtu, .vtp): escaping, field checks and the
+// DataArrays of one file in either encoding. Not installed.
+#include <cstdint>
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "strata/core/io/vtu.hpp"
 
@@ -17,13 +19,36 @@ std::string escape(const std::string& text);
 void check_field_rows(const std::filesystem::path& path, const VtuFields& fields, Index num_points,
                       Index num_cells);
 
-/// One ASCII DataArray (Float64 in shortest round-trip form, or Int32), rows of `values`.
-void write_data_array(std::ostream& out, const std::string& name, const Eigen::MatrixXd& values);
-void write_data_array(std::ostream& out, const std::string& name, const Eigen::MatrixXi& values);
+/// The DataArrays of one VTK XML file. ASCII arrays are written in place (doubles in shortest
+/// round-trip form); binary arrays become `format="appended"` references into the
+/// <AppendedData encoding="raw"> block that `end_file` writes, each compressed by zlib in blocks
+/// behind a UInt64 header (VTK's vtkZLibDataCompressor layout).
+class DataArrayWriter {
+ public:
+  explicit DataArrayWriter(VtkEncoding encoding) : m_encoding(encoding) {}
 
-/// The <PointData> and <CellData> of `fields` (each only if non-empty), then <Points> with
-/// `positions` (#V × 3), as a piece of a .vtu or .vtp writes them.
-void write_fields_and_points(std::ostream& out, const VtuFields& fields,
-                             ConstRef<MatrixX3d> positions);
+  /// `<?xml …?>` and the `<VTKFile type="…">` start tag (with the compressor when binary).
+  void begin_file(std::ostream& out, const char* type) const;
+
+  /// One DataArray of `values`, `components` per tuple; `name` may be empty (the Points array).
+  /// Float64 for double, Int32 / Int64 / UInt8 for the integer types.
+  template <typename T>
+  void write(std::ostream& out, const std::string& name, int components,
+             const std::vector<T>& values);
+
+  /// The <PointData> and <CellData> of `fields` (each only if non-empty), then <Points> with
+  /// `positions` (#V × 3), as a piece of a .vtu or .vtp holds them.
+  void write_fields_and_points(std::ostream& out, const VtuFields& fields,
+                               ConstRef<MatrixX3d> positions);
+
+  /// `</VTKFile>`, preceded by the appended data when binary.
+  void end_file(std::ostream& out) const;
+
+ private:
+  void append_compressed(const std::uint8_t* data, std::size_t size);
+
+  VtkEncoding m_encoding;
+  std::vector<std::uint8_t> m_appended;
+};
 
 }  // namespace strata::vtk_xml

@@ -1,5 +1,6 @@
 #include "strata/core/io/vtp.hpp"
 
+#include <cstdint>
 #include <ostream>
 #include <string>
 
@@ -15,7 +16,7 @@ namespace {
 /// section, "Polys" or "Lines".
 void write_polydata(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
                     const std::vector<int>& connectivity, int nodes, const char* section,
-                    const VtuFields& fields) {
+                    const VtuFields& fields, VtkEncoding encoding) {
   const Index num_points = positions.rows();
   const auto num_cells = static_cast<Index>(connectivity.size()) / nodes;
   vtk_xml::check_field_rows(path, fields, num_points, num_cells);
@@ -25,55 +26,48 @@ void write_polydata(const std::filesystem::path& path, ConstRef<MatrixX3d> posit
                        (nodes == 3 ? "triangle" : "segment") + " refers to a point outside 0.." +
                        std::to_string(num_points - 1));
   const bool lines = std::string(section) == "Lines";
+  std::vector<std::int64_t> indices(connectivity.begin(), connectivity.end());
+  std::vector<std::int64_t> offsets(static_cast<std::size_t>(num_cells));
+  for (Index c = 0; c < num_cells; ++c)
+    offsets[c] = nodes * (c + 1);
   write_file_atomically(path, [&](std::ostream& out) {
-    out << "<?xml version=\"1.0\"?>\n"
-           "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\" "
-           "header_type=\"UInt64\">\n"
-           "  <PolyData>\n"
+    vtk_xml::DataArrayWriter arrays(encoding);
+    arrays.begin_file(out, "PolyData");
+    out << "  <PolyData>\n"
         << "    <Piece NumberOfPoints=\"" << num_points << "\" NumberOfVerts=\"0\" NumberOfLines=\""
         << (lines ? num_cells : 0) << "\" NumberOfStrips=\"0\" NumberOfPolys=\""
         << (lines ? 0 : num_cells) << "\">\n";
-    vtk_xml::write_fields_and_points(out, fields, positions);
-    out << "      <" << section
-        << ">\n"
-           "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (Index c = 0; c < num_cells; ++c) {
-      out << "         ";
-      for (int k = 0; k < nodes; ++k)
-        out << ' ' << connectivity[nodes * c + k];
-      out << '\n';
-    }
-    out << "        </DataArray>\n"
-           "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (Index c = 0; c < num_cells; ++c)
-      out << (c % 16 == 0 ? "          " : " ") << nodes * (c + 1)
-          << (c % 16 == 15 || c + 1 == num_cells ? "\n" : "");
-    out << "        </DataArray>\n      </" << section
-        << ">\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+    arrays.write_fields_and_points(out, fields, positions);
+    out << "      <" << section << ">\n";
+    arrays.write(out, "connectivity", nodes, indices);
+    arrays.write(out, "offsets", 1, offsets);
+    out << "      </" << section << ">\n    </Piece>\n  </PolyData>\n";
+    arrays.end_file(out);
   });
 }
 
 }  // namespace
 
 void write_vtp(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
-               ConstRef<MatrixX3i> triangles, const VtuFields& fields) {
+               ConstRef<MatrixX3i> triangles, const VtuFields& fields, VtkEncoding encoding) {
   std::vector<int> connectivity;
   connectivity.reserve(3 * triangles.rows());
   for (Index f = 0; f < triangles.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       connectivity.push_back(triangles(f, k));
-  write_polydata(path, positions, connectivity, 3, "Polys", fields);
+  write_polydata(path, positions, connectivity, 3, "Polys", fields, encoding);
 }
 
 void write_vtp_lines(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
-                     const std::vector<std::array<int, 2>>& segments, const VtuFields& fields) {
+                     const std::vector<std::array<int, 2>>& segments, const VtuFields& fields,
+                     VtkEncoding encoding) {
   std::vector<int> connectivity;
   connectivity.reserve(2 * segments.size());
   for (const auto& [a, b] : segments) {
     connectivity.push_back(a);
     connectivity.push_back(b);
   }
-  write_polydata(path, positions, connectivity, 2, "Lines", fields);
+  write_polydata(path, positions, connectivity, 2, "Lines", fields, encoding);
 }
 
 }  // namespace strata

@@ -1,3 +1,4 @@
+#include <cstdint>
 #include <ostream>
 #include <string>
 
@@ -15,41 +16,38 @@ constexpr int kVtkTetra = 10;  ///< VTK cell type of a linear tetrahedron
 }  // namespace
 
 void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
-               ConstRef<MatrixX4i> tets, const VtuFields& fields) {
+               ConstRef<MatrixX4i> tets, const VtuFields& fields, VtkEncoding encoding) {
   const Index num_points = positions.rows();
   const Index num_cells = tets.rows();
   vtk_xml::check_field_rows(path, fields, num_points, num_cells);
 
+  std::vector<std::int64_t> connectivity(static_cast<std::size_t>(4 * num_cells));
+  std::vector<std::int64_t> offsets(static_cast<std::size_t>(num_cells));
+  for (Index t = 0; t < num_cells; ++t) {
+    for (int k = 0; k < 4; ++k)
+      connectivity[4 * t + k] = tets(t, k);
+    offsets[t] = 4 * (t + 1);
+  }
+  const std::vector<std::uint8_t> types(static_cast<std::size_t>(num_cells), kVtkTetra);
+
   write_file_atomically(path, [&](std::ostream& out) {
-    out << "<?xml version=\"1.0\"?>\n"
-           "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\" "
-           "header_type=\"UInt64\">\n"
-           "  <UnstructuredGrid>\n"
+    vtk_xml::DataArrayWriter arrays(encoding);
+    arrays.begin_file(out, "UnstructuredGrid");
+    out << "  <UnstructuredGrid>\n"
         << "    <Piece NumberOfPoints=\"" << num_points << "\" NumberOfCells=\"" << num_cells
         << "\">\n";
-    vtk_xml::write_fields_and_points(out, fields, positions);
-    out << "            <Cells>\n"
-           "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (Index t = 0; t < num_cells; ++t)
-      out << "          " << tets(t, 0) << ' ' << tets(t, 1) << ' ' << tets(t, 2) << ' '
-          << tets(t, 3) << '\n';
-    out << "        </DataArray>\n"
-           "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (Index t = 0; t < num_cells; ++t)
-      out << (t % 16 == 0 ? "          " : " ") << 4 * (t + 1)
-          << (t % 16 == 15 || t + 1 == num_cells ? "\n" : "");
-    out << "        </DataArray>\n"
-           "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (Index t = 0; t < num_cells; ++t)
-      out << (t % 16 == 0 ? "          " : " ") << kVtkTetra
-          << (t % 16 == 15 || t + 1 == num_cells ? "\n" : "");
-    out << "        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n"
-           "</VTKFile>\n";
+    arrays.write_fields_and_points(out, fields, positions);
+    out << "      <Cells>\n";
+    arrays.write(out, "connectivity", 4, connectivity);
+    arrays.write(out, "offsets", 1, offsets);
+    arrays.write(out, "types", 1, types);
+    out << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n";
+    arrays.end_file(out);
   });
 }
 
-void write_vtu(const std::filesystem::path& path, const TetMesh& mesh) {
-  write_vtu(path, mesh.vertices, mesh.tets);
+void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, VtkEncoding encoding) {
+  write_vtu(path, mesh.vertices, mesh.tets, {}, encoding);
 }
 
 }  // namespace strata

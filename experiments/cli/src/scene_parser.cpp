@@ -305,7 +305,7 @@ ObstacleSpec parse_obstacle(const SceneValue& value, const std::filesystem::path
 }
 
 OutputSpec parse_output(const SceneValue& value) {
-  value.expect_object({"every", "probes", "vtk"});
+  value.expect_object({"every", "probes", "vtk", "vtk_encoding"});
   OutputSpec output;
   if (value.has("every")) output.every = value.at("every").integer(1);
   if (value.has("probes")) {
@@ -321,6 +321,11 @@ OutputSpec parse_output(const SceneValue& value) {
     } else {
       output.vtk = vtk.boolean();
     }
+  }
+  if (value.has("vtk_encoding")) {
+    output.vtk_encoding = value.at("vtk_encoding").choice({"binary", "ascii"}) == 1
+                              ? VtkEncoding::ascii
+                              : VtkEncoding::binary;
   }
   return output;
 }

@@ -433,7 +433,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                        std::move(probe_locations));
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");
   std::optional<VtkSeries> vtk;
-  if (scene.output.vtk) vtk.emplace(summary.output_dir, scene.name, scene.output.vtk_mesh);
+  if (scene.output.vtk)
+    vtk.emplace(summary.output_dir, scene.name, scene.output.vtk_mesh, scene.output.vtk_encoding);
   if (surface) {
     if (!options.quiet) {
       log << "strata: surface " << scene.mesh.surface->string() << ": "

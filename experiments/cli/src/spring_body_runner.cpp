@@ -141,7 +141,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
       surface_fields.add_point_data("displacement", displacement.topRows(S));
       surface_fields.add_point_data("velocity", velocity.topRows(S));
       write_vtp(summary.output_dir / (scene.name + name), positions.topRows(S), body.triangles,
-                surface_fields);
+                surface_fields, scene.output.vtk_encoding);
       pvd->add_frame(t, scene.name + name, 0);
       std::vector<std::array<int, 2>> lines;
       for (const auto& [a, b] : body.skeleton_segments)
@@ -150,7 +150,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
       skeleton_fields.add_point_data("displacement", displacement.bottomRows(V - S));
       std::snprintf(name, sizeof name, "_skeleton_%06d.vtp", summary.frames);
       write_vtp_lines(summary.output_dir / (scene.name + name), positions.bottomRows(V - S), lines,
-                      skeleton_fields);
+                      skeleton_fields, scene.output.vtk_encoding);
       pvd->add_frame(t, scene.name + name, 1);
     }
     ++summary.frames;

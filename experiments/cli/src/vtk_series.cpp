@@ -27,11 +27,13 @@ std::filesystem::path prepare_series(const std::filesystem::path& folder, const 
 
 }  // namespace
 
-VtkSeries::VtkSeries(const std::filesystem::path& folder, const std::string& stem, bool mesh_frames)
+VtkSeries::VtkSeries(const std::filesystem::path& folder, const std::string& stem, bool mesh_frames,
+                     VtkEncoding encoding)
     : m_folder(folder),
       m_stem(stem),
       m_pvd(prepare_series(folder, stem)),
-      m_mesh_frames(mesh_frames) {}
+      m_mesh_frames(mesh_frames),
+      m_encoding(encoding) {}
 
 void VtkSeries::write_frame(double time, const Simulation& simulation, const VectorXi* levels) {
   if (!m_mesh_frames) {
@@ -69,7 +71,7 @@ void VtkSeries::write_frame(double time, const Simulation& simulation, const Vec
   char name[32];
   std::snprintf(name, sizeof name, "_%06d.vtu", m_frames);
   const std::string file = m_stem + name;
-  write_vtu(m_folder / file, positions, mesh.tets, fields);
+  write_vtu(m_folder / file, positions, mesh.tets, fields, m_encoding);
   m_pvd.add_frame(time, file);
   ++m_frames;
 }
@@ -79,7 +81,7 @@ void VtkSeries::write_surface_frame(double time, ConstRef<MatrixX3d> positions,
   char name[40];
   std::snprintf(name, sizeof name, "_surface_%06d.vtp", std::max(m_frames - 1, 0));
   const std::string file = m_stem + name;
-  write_vtp(m_folder / file, positions, triangles, fields);
+  write_vtp(m_folder / file, positions, triangles, fields, m_encoding);
   m_pvd.add_frame(time, file, 1);
 }
 

@@ -14,6 +14,13 @@
 
 namespace strata {
 
+/// How the VTK XML writers store their arrays. Both are exact: binary holds the doubles' bytes,
+/// ASCII their shortest round-trip text.
+enum class VtkEncoding {
+  binary,  ///< appended raw data, zlib-compressed (vtkZLibDataCompressor); several times smaller
+  ascii,   ///< text arrays, readable in an editor
+};
+
 /// Named per-vertex and per-tet arrays written with a frame. Each matrix has one row per vertex
 /// (#V × k) or per tet (#T × k) and k components: 1 for scalars, 3 for vectors, 6 for symmetric
 /// tensors. ParaView reads 6 components as (xx, yy, zz, xy, yz, xz).
@@ -41,20 +48,44 @@ struct VtuFields {
   }
 };
 
-/// Writes one frame as an ASCII .vtu, atomically: `positions` (#V × 3, current positions), `tets`
-/// (#T × 4, VTK cell type 10) and the named `fields` (Float64 / Int32 arrays). Doubles are written
-/// in shortest round-trip form, so reading gives back the identical values. Throws InputError
-/// naming the path and field when a field's row count does not match #V or #T.
+/// Writes one frame as a .vtu, atomically: `positions` (#V × 3, current positions), `tets`
+/// (#T × 4, VTK cell type 10) and the named `fields` (Float64 / Int32 arrays), in `encoding`.
+/// Reading gives back the identical doubles in either encoding. Throws InputError naming the path
+/// and field when a field's row count does not match #V or #T.
 void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
-               ConstRef<MatrixX4i> tets, const VtuFields& fields = {});
+               ConstRef<MatrixX4i> tets, const VtuFields& fields = {},
+               VtkEncoding encoding = VtkEncoding::binary);
 
 /// Writes a rest mesh as .vtu (no fields).
-void write_vtu(const std::filesystem::path& path, const TetMesh& mesh);
+void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
+               VtkEncoding encoding = VtkEncoding::binary);
+
+/// The arrays of one .vtu or .vtp frame, as read back: what a run wrote, for checks and
+/// post-processing.
+struct VtkFrame {
+  std::string type;        ///< "UnstructuredGrid" (.vtu) or "PolyData" (.vtp)
+  Eigen::MatrixXd points;  ///< #V × 3
+  /// Named point (#V × k) and cell (#cells × k) arrays; integer arrays as doubles.
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> point_data, cell_data;
+  /// The topology arrays by section and name, flat: "Cells/connectivity", "Cells/offsets",
+  /// "Cells/types" of a .vtu; "Polys/connectivity", "Lines/offsets", … of a .vtp.
+  std::vector<std::pair<std::string, std::vector<double>>> cells;
+
+  /// The named array; throws InputError when the frame has none of that name.
+  const Eigen::MatrixXd& point_field(const std::string& name) const;
+  const Eigen::MatrixXd& cell_field(const std::string& name) const;
+};
+
+/// Reads a single-piece .vtu or .vtp in any encoding read_vtu accepts. Throws InputError naming
+/// the file on malformed input or arrays whose size does not match the piece's counts.
+VtkFrame read_vtk_frame(const std::filesystem::path& path);
 
 /// Reads the points and the tetrahedra (cell type 10) of a single-piece UnstructuredGrid .vtu;
-/// other cell types and all point/cell data are ignored. DataArrays may be ASCII or inline
-/// base64 binary (uncompressed, little endian); appended and compressed data are rejected.
-/// Throws InputError naming the file (and line where known) on malformed input or no tets.
+/// other cell types and all point/cell data are ignored. DataArrays may be ASCII, inline base64
+/// binary or appended raw binary, each uncompressed or zlib-compressed (little endian, UInt32 or
+/// UInt64 headers): what strata, ParaView and meshio write. Appended base64 data and other
+/// compressors are rejected. Throws InputError naming the file (and line where known) on malformed
+/// input or no tets.
 TetMesh read_vtu(const std::filesystem::path& path);
 
 }  // namespace strata

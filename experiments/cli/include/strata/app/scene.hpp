@@ -11,6 +11,7 @@
 
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/material.hpp"
+#include "strata/core/io/vtu.hpp"
 #include "strata/core/sim/dirichlet.hpp"
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/loads.hpp"
@@ -71,6 +72,8 @@ struct OutputSpec {
   /// With vtk: the simulation mesh's .vtu frames too; false ("vtk": "surface"): only the bound
   /// fine surface's .vtp frames.
   bool vtk_mesh = true;
+  /// "vtk_encoding": how the frames store their arrays ("binary": appended, zlib-compressed).
+  VtkEncoding vtk_encoding = VtkEncoding::binary;
 };
 
 /// A whole scene. Dirichlet groups are named by their key paths ("fixed.0", "prescribed.1"),

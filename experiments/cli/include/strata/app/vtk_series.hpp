@@ -18,8 +18,10 @@ namespace strata::app {
 class VtkSeries {
  public:
   /// Removes frames `<stem>_NNNNNN.vtu` of an older run in `folder` and starts an empty .pvd.
-  /// `mesh_frames` false: write_frame writes no .vtu (only the surface frames are kept).
-  VtkSeries(const std::filesystem::path& folder, const std::string& stem, bool mesh_frames = true);
+  /// `mesh_frames` false: write_frame writes no .vtu (only the surface frames are kept). Frames are
+  /// written in `encoding`.
+  VtkSeries(const std::filesystem::path& folder, const std::string& stem, bool mesh_frames = true,
+            VtkEncoding encoding = VtkEncoding::binary);
 
   /// Writes the simulation's current state as the next frame at `time` (load factor when static).
   /// `levels` (#T, optional): the tree level of each cell (active cut of a hierarchy); 0 without.
@@ -39,6 +41,7 @@ class VtkSeries {
   PvdWriter m_pvd;
   int m_frames = 0;
   bool m_mesh_frames = true;
+  VtkEncoding m_encoding = VtkEncoding::binary;
 };
 
 }  // namespace strata::app
