@@ -11,8 +11,8 @@
 #include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
-#include "strata/core/io/vtu.hpp"
 #include "strata/core/io/tetgen.hpp"
+#include "strata/core/io/vtu.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 
 namespace strata {

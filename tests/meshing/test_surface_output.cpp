@@ -29,6 +29,16 @@ std::string run_python(const std::string& script) {
   return output;
 }
 
+/// The numbers `script` prints.
+std::vector<double> printed_numbers(const std::string& script) {
+  std::istringstream output(run_python(script));
+  std::vector<double> values;
+  double value;
+  while (output >> value)
+    values.push_back(value);
+  return values;
+}
+
 /// Every number of the named DataArray (or of Points, connectivity, offsets) of an ASCII .vtp,
 /// read by python's XML parser.
 std::vector<double> parse_ascii_array(const std::filesystem::path& path, const std::string& name) {
@@ -43,12 +53,7 @@ std::vector<double> parse_ascii_array(const std::filesystem::path& path, const s
       name +
       "\"][0]\n"
       "print(\" \".join(repr(float(x)) for x in a.text.split()))\n";
-  std::istringstream output(run_python(script));
-  std::vector<double> values;
-  double value;
-  while (output >> value)
-    values.push_back(value);
-  return values;
+  return printed_numbers(script);
 }
 
 /// The same for a binary .vtp (appended raw, zlib, UInt64 headers), decoded by python's zlib and
@@ -80,12 +85,7 @@ std::vector<double> parse_binary_array(const std::filesystem::path& path, const 
       "  raw+=zlib.decompress(d[p:p+c]); p+=c\n"
       "v=struct.unpack(\"<%d%s\"%(len(raw)//struct.calcsize(k),k),raw)\n"
       "print(\" \".join(repr(float(x)) for x in v))\n";
-  std::istringstream output(run_python(script));
-  std::vector<double> values;
-  double value;
-  while (output >> value)
-    values.push_back(value);
-  return values;
+  return printed_numbers(script);
 }
 
 class SurfaceOutputEncoding : public ::testing::TestWithParam<VtkEncoding> {};
