@@ -330,6 +330,22 @@ def cut_for(args, spec, settings, threads):
     return cut
 
 
+# strata rewrites this file in a run's folder with "<fraction done> <seconds elapsed>".
+PROGRESS_FILE = "progress.txt"
+
+
+def run_eta(folder):
+    """(fraction done, seconds left) of a running run from its progress file, or None."""
+    try:
+        with open(os.path.join(folder, PROGRESS_FILE)) as f:
+            fraction, elapsed = (float(v) for v in f.read().split())
+    except (OSError, ValueError):
+        return None
+    if fraction <= 0.0:
+        return None
+    return fraction, elapsed * (1.0 - fraction) / fraction
+
+
 def scene_of(spec, settings):
     return settings.get(SCENE_KEY, spec["scene"])
 
@@ -347,7 +363,7 @@ def run_folder(args, spec, name, settings):
 
 def command_for(args, spec, folder, settings, threads):
     command = [args.strata, "run", scene_of(spec, settings), "--out", folder, "--quiet",
-               "--set", "output.vtk=false"]
+               "--progress-file", os.path.join(folder, PROGRESS_FILE), "--set", "output.vtk=false"]
     if threads > 0:
         command += ["--threads", str(threads)]
     for key, value in list(spec["set"].items()) + list(settings.items()):
@@ -434,6 +450,20 @@ def draw_pictures(args, spec):
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         print(f"experiment: rendering failed: {result.stderr.strip()[-300:]}", file=sys.stderr)
+    # The bound fine surface at the same frames, coloured by its displacement.
+    surfaces = sorted(f for f in os.listdir(folder) if re.fullmatch(r".*_surface_\d{6}\.vtp", f))
+    if len(surfaces) == len(frames):
+        chosen = [os.path.join(folder, surfaces[round(f * (len(surfaces) - 1))])
+                  for f in pictures["frames"]]
+        command = [sys.executable, os.path.join(HERE, "render.py"), *chosen,
+                   "--out", os.path.join(args.out, spec["name"], "surface.png"),
+                   "--fields", "displacement", "--exaggerate", str(pictures["exaggerate"]),
+                   "--view", *[str(v) for v in pictures["view"]], "--up", pictures["up"],
+                   "--titles", *[f"{t}, fine surface" for t in pictures["titles"]]]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            print(f"experiment: rendering the fine surface failed: "
+                  f"{result.stderr.strip()[-300:]}", file=sys.stderr)
     if pictures.get("gif"):
         series = [f for f in os.listdir(folder) if f.endswith(".pvd")]
         if not series:
@@ -499,6 +529,7 @@ def summarise(args, spec):
             history = hierarchy.get("history", {})
             row.update({
                 "status": stats.get("status", row["status"]),
+                "message": stats.get("message", ""),
                 "strata_wall_seconds": stats.get("wall_seconds"),
                 "element_evaluations": stats.get("element_evaluations"),
                 "newton_iterations": stats.get("newton_iterations"),
@@ -512,8 +543,12 @@ def summarise(args, spec):
                 "tolerance_met": hierarchy.get("tolerance_met"),
                 "recorded_tolerance": hierarchy.get("precomputed", {}).get("recorded_tolerance"),
                 "final_energies": stats.get("energies"),
-                "history": {k: history.get(k, []) for k in ("time", "tets", "dofs",
-                                                             "estimated_error")},
+                "history": {**{k: history.get(k, []) for k in ("time", "tets", "dofs",
+                                                                "estimated_error")},
+                            # cut changes: time, DOFs after, refined and coarsened nodes
+                            "changes": [[c.get("time"), c.get("dofs_after"), c.get("refined", 0),
+                                         c.get("coarsened", 0)]
+                                        for c in hierarchy.get("changes", [])]},
             })
         has_probes = os.path.exists(os.path.join(folder, "probes.csv"))
         row["probes"] = read_probes(folder) if has_probes else {}
@@ -588,7 +623,7 @@ def surface_error(reference, frames):
 
 
 COLUMNS = ["run", "kind", "level", "tolerance", "variant", "windows", "training_seconds", "status",
-           "error", "surface_error", "energy_difference",
+           "message", "error", "surface_error", "energy_difference",
            "estimated_error",
            "effectivity", "tolerance_met", "wall_seconds", "cpu_seconds", "speedup",
            "max_active_tets", "max_dofs", "element_evaluations", "newton_iterations",
@@ -650,13 +685,19 @@ def write_results(args, spec, rows):
         for r in adaptive:
             h = r["history"]
             line, = axes[0].plot(h["time"], h["dofs"], label=f"τ={r['tolerance']:g}")
+            # The refinement events: ▲ where a cut change refined, ▼ where it only coarsened.
+            for marker, events in (("^", [c for c in h.get("changes", []) if c[2] > 0]),
+                                   ("v", [c for c in h.get("changes", []) if c[2] == 0])):
+                if events:
+                    axes[0].plot([c[0] for c in events], [c[1] for c in events], marker,
+                                 color=line.get_color(), markersize=5, linestyle="none")
             times = [t for t, _ in r["error_over_time"]]
             axes[1].plot(times, [max(e, 1e-6) for _, e in r["error_over_time"]], "-",
                          color=line.get_color(), label=f"true, τ={r['tolerance']:g}")
             axes[1].plot(h["time"], [max(e, 1e-6) for e in h["estimated_error"]], "--",
                          color=line.get_color(), label=f"estimated, τ={r['tolerance']:g}")
         axes[0].set_xlabel("time [s] (static: load factor)")
-        axes[0].set_ylabel("active DOFs")
+        axes[0].set_ylabel("active DOFs (▲ refined, ▼ coarsened)")
         axes[1].set_xlabel("time [s] (static: load factor)")
         axes[1].set_ylabel("error")
         axes[1].set_yscale("log")
@@ -724,14 +765,29 @@ def main():
         running = set()
         lock = threading.Lock()
 
+        folders = {r[0]: run_folder(args, spec, r[0], r[2]) for r in runs}
+
         def progress():
+            # Each running run: its share done and ETA from strata's progress file; the sweep's
+            # ETA: the running runs' ETAs plus the mean duration of a finished run for each run
+            # not started, spread over the jobs.
+            shown, left_running = [], 0.0
+            for name in sorted(running):
+                eta = run_eta(folders[name])
+                if eta is None:
+                    shown.append(name)
+                else:
+                    shown.append(f"{name} {100 * eta[0]:.0f} % ETA {eta[1]:.0f} s")
+                    left_running += eta[1]
             mean = sum(durations) / len(durations) if durations else None
-            left = len(runs) - done
-            eta = f"{mean * left / args.jobs:.0f} s" if mean is not None else "?"
-            names = ", ".join(sorted(running)) or "-"
-            print(f"\rexperiment {spec['name']}: {done}/{len(runs)} done, running {names}, "
-                  f"elapsed {time.monotonic() - start:.0f} s, sweep ETA {eta}   ",
-                  end="", file=sys.stderr, flush=True)
+            waiting = len(runs) - done - len(running)
+            if mean is not None or waiting == 0:
+                eta = f"{(left_running + (mean or 0.0) * waiting) / args.jobs:.0f} s"
+            else:
+                eta = "?"
+            print(f"\rexperiment {spec['name']}: {done}/{len(runs)} done, running "
+                  f"{', '.join(shown) or '-'}; elapsed {time.monotonic() - start:.0f} s, "
+                  f"sweep ETA {eta}\033[K", end="", file=sys.stderr, flush=True)
 
         def one(run):
             nonlocal done
@@ -748,8 +804,20 @@ def main():
                           f"{record['stderr'].strip().splitlines()[-1:]}", file=sys.stderr)
                 progress()
 
+        finished = threading.Event()
+
+        def ticker():  # redraws the line while runs go on, so that their ETAs move
+            while not finished.wait(2.0):
+                with lock:
+                    if running:
+                        progress()
+
+        watcher = threading.Thread(target=ticker, daemon=True)
+        watcher.start()
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
             list(pool.map(one, pending))
+        finished.set()
+        watcher.join()
         print(file=sys.stderr)
     if args.only:
         # One run of a spread sweep: the report is built once, with --report-only.

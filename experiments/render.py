@@ -8,8 +8,9 @@
 
 One panel per frame and field (rows: frames, columns: fields). A frame is a .vtu that `strata
 run` writes (positions already deformed); its boundary triangles (the tet faces that belong to
-one tet) are drawn with the colour of their tet's value, painter-sorted by depth, with a colour
-bar per field shared by the frames. The surface .vtp frames of a bound fine surface are drawn
+one tet) are drawn with the colour of their tet's value, lit by a light above the viewer
+(Lambert shading with ambient light) and painter-sorted by depth, with a colour bar per field
+shared by the frames. The surface .vtp frames of a bound fine surface are drawn
 the same way (point fields are averaged per triangle). Fields: any cell field of the frame —
 `level` (active tree level, integer colours), `von_mises` [Pa], `plastic_strain`, `stress` or
 `green_strain` (the first Voigt component) — or a point field (`displacement` magnitude).
@@ -129,10 +130,27 @@ def colour_range(per_frame, integer):
 UP = {"x": [1, 2, 0], "y": [2, 0, 1], "z": [0, 1, 2]}
 
 
+def shade(colours, polygons, elevation, azimuth):
+    """The colours lit by a light above the viewer (Lambert, two-sided, with ambient light), so
+    that the shape reads in depth; the hue still carries the field."""
+    e, a = np.radians(elevation), np.radians(azimuth)
+    eye = np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+    light = eye + np.array([0.0, 0.0, 0.6])
+    light /= np.linalg.norm(light)
+    normals = np.cross(polygons[:, 1] - polygons[:, 0], polygons[:, 2] - polygons[:, 0])
+    lengths = np.linalg.norm(normals, axis=1)
+    lengths[lengths == 0.0] = 1.0
+    lit = 0.45 + 0.55 * np.abs(normals @ light) / lengths
+    out = np.array(colours, dtype=float)
+    out[:, :3] *= lit[:, None]
+    return out
+
+
 def draw(axis, points, faces, colours, elevation, azimuth, up="z"):
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     points = points[:, UP[up]]
     polygons = points[faces]
+    colours = shade(colours, polygons, elevation, azimuth)
     axis.add_collection3d(Poly3DCollection(polygons, facecolors=colours, edgecolors=(0, 0, 0, 0.15),
                                            linewidths=0.2))
     lo, hi = points.min(axis=0), points.max(axis=0)

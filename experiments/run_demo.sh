@@ -2,9 +2,9 @@
 # Demo: installs what is missing and builds only the strata command-line tool (.ci/setup.sh with
 # STRATA_BUILD_TARGETS=strata; no tests or benchmarks), then runs the short version of the
 # experiments suite — every scene of experiments/specs at full resolution, at every uniform level
-# and adaptively at two tolerances (experiment.py --quick) — and the stability map on its coarse
-# grid (stability_map.py --quick), and writes the report with its charts (report.py) to
-# out/demo/REPORT.md. A few minutes on 2 cores after the build.
+# and adaptively at two tolerances (experiment.py --quick) — and the stability maps on their coarse
+# grids (stability_map.py --quick, over stiffness and over compression), and writes the report
+# with its charts (report.py) to out/demo/REPORT.md. A few minutes on 2 cores after the build.
 #
 # Usage: ./experiments/run_demo.sh [--full]   (--full: the whole sweep, four tolerances and the
 #                                              scenes' full durations; much longer)
@@ -12,11 +12,15 @@ set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${STRATA_BUILD_DIR:-${repo_root}/build}"
+# The short suite runs two runs at once, one thread each (its timings are ratios of runs that
+# shared the machine); the full sweep runs one at a time on every core.
 quick=(--quick)
+jobs=(--jobs 2)
 results="${repo_root}/out/demo/runs"
 report="${repo_root}/out/demo"
 if [[ "${1:-}" == "--full" ]]; then
   quick=()
+  jobs=()
   results="${repo_root}/out/experiments"
   report="${repo_root}/experiments/results"
 fi
@@ -34,11 +38,13 @@ for spec in "${specs[@]}"; do
     echo "demo: skipping ${spec} (needs the CGAL models in build/data/models)"
     continue
   fi
-  /usr/bin/python3 "${repo_root}/experiments/experiment.py" "${spec}" "${quick[@]}" \
+  /usr/bin/python3 "${repo_root}/experiments/experiment.py" "${spec}" "${quick[@]}" "${jobs[@]}" \
     --out "${results}" --strata "${strata}"
 done
-/usr/bin/python3 "${repo_root}/experiments/stability_map.py" "${quick[@]}" \
-  --out "${results}/stability" --strata "${strata}"
+for axis in stiffness compression; do
+  /usr/bin/python3 "${repo_root}/experiments/stability_map.py" "${quick[@]}" --axis "${axis}" \
+    --out "${results}/stability" --strata "${strata}"
+done
 /usr/bin/python3 "${repo_root}/experiments/report.py" "${specs[@]}" --results "${results}" \
   --out "${report}" --strata "${strata}" --stability "${results}/stability"
 echo "demo: the experiments took $(($(date +%s) - start)) s"

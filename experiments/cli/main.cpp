@@ -90,6 +90,10 @@ int main(int argc, char** argv) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   run->add_flag("-q,--quiet", quiet, "No progress bar, info lines or summary");
+  std::string progress_file;
+  run->add_option("--progress-file", progress_file,
+                  "Rewrite this file with '<fraction done> <seconds elapsed>' as the run goes "
+                  "(at most twice a second), for programs that watch the run");
   int threads = 0;
   run->add_option("--threads", threads,
                   "Threads of strata's parallel loops (default 0: every core); the BLAS and "
@@ -183,6 +187,7 @@ int main(int argc, char** argv) {
       options.output_dir = out_dir;
       options.quiet = quiet;
       options.progress = !quiet && strata::app::stderr_is_terminal();
+      options.progress_file = progress_file;
       strata::app::run_scene(scene, options);
     } else if (*precompute) {
       precompute_command.progress = !precompute_command.quiet && strata::app::stderr_is_terminal();

@@ -34,6 +34,23 @@ std::filesystem::path write_scene(const TempFolder& folder, const json& scene,
   return path;
 }
 
+TEST(CliEndToEnd, ProgressFileEndsAtTheWholeRun) {
+  TempFolder folder;
+  write_scene(folder, bar_scene());
+  const CliResult result =
+      run_strata("run scene.json --quiet --progress-file progress.txt", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;  // --quiet: the file, not a bar on stderr
+  std::istringstream line(read_text(folder.path() / "progress.txt"));
+  double fraction = -1.0;
+  double elapsed = -1.0;
+  ASSERT_TRUE(line >> fraction >> elapsed) << read_text(folder.path() / "progress.txt");
+  EXPECT_EQ(fraction, 1.0);  // written at the last step, whatever the throttle
+  EXPECT_GE(elapsed, 0.0);
+  const json stats = read_json(folder.path() / "out" / "scene" / "stats.json");
+  EXPECT_LE(elapsed, stats["wall_seconds"].get<double>() + 1e-3);
+}
+
 TEST(CliEndToEnd, StaticGravityReactionEqualsWeight) {
   TempFolder folder;
   write_scene(folder, bar_scene());

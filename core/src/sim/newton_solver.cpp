@@ -207,8 +207,11 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
         trial_g = reduction.restrict_vector(trial_gradient);
       }
       if (!(std::isfinite(trial_energy) && trial_g.norm() < result.residual)) {
-        // Nothing lowers E or ‖g‖: converged if the correction is at round-off level.
-        if (increment <= settings.stall_tolerance * displacement_scale(settings, x))
+        // Nothing lowers E or ‖g‖: converged if the correction is at round-off level, or the
+        // residual is already small against the forces at work (a symmetric state past a
+        // bifurcation, whose exact Hessian is indefinite, stalls here).
+        if (increment <= settings.stall_tolerance * displacement_scale(settings, x) ||
+            result.residual <= settings.stall_residual_tolerance * settings.force_scale)
           return finish(NewtonCriterion::stall);
         return result;
       }

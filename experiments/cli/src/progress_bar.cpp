@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <utility>
 
 namespace strata::app {
 
@@ -27,16 +29,32 @@ std::string format_duration(double seconds) {
   return text;
 }
 
-ProgressBar::ProgressBar(bool enabled)
-    : m_enabled(enabled), m_start(std::chrono::steady_clock::now()), m_last_draw(m_start) {}
+ProgressBar::ProgressBar(bool enabled, std::filesystem::path file)
+    : m_enabled(enabled),
+      m_file(std::move(file)),
+      m_start(std::chrono::steady_clock::now()),
+      m_last_draw(m_start),
+      m_last_write(m_start) {}
 
 ProgressBar::~ProgressBar() {
   clear();
 }
 
+void ProgressBar::write_file(double fraction, double elapsed) {
+  // A reader may see the file truncated for a moment; it retries on its next poll.
+  std::ofstream out(m_file, std::ios::trunc);
+  if (out) out << fraction << ' ' << elapsed << '\n';
+}
+
 void ProgressBar::update(double fraction, const std::string& label) {
-  if (!m_enabled) return;
   const auto now = std::chrono::steady_clock::now();
+  if (!m_file.empty() &&
+      (now - m_last_write >= std::chrono::milliseconds(500) || fraction >= 1.0)) {
+    m_last_write = now;
+    write_file(std::clamp(fraction, 0.0, 1.0),
+               std::chrono::duration<double>(now - m_start).count());
+  }
+  if (!m_enabled) return;
   if (m_drawn && now - m_last_draw < std::chrono::milliseconds(100) && fraction < 1.0) return;
   m_last_draw = now;
   fraction = std::clamp(fraction, 0.0, 1.0);

@@ -252,8 +252,8 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                      {"multigrid_direct_fallbacks", counters.multigrid_direct_fallbacks}};
   if (counters.stalled_steps > 0)
     stats["newton"]["note"] = std::to_string(counters.stalled_steps) +
-                              " Newton solve(s) stopped with the residual stalled at round-off "
-                              "(up to " +
+                              " Newton solve(s) stopped with the residual stalled (at round-off, "
+                              "or below 1e-5 of the load scale) (up to " +
                               std::to_string(counters.max_residual_ratio) +
                               " x the residual target) and were accepted as converged";
   stats["threads"] = max_threads();
@@ -497,7 +497,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   save_tables();
   if (options.on_step && scene_simulation.adaptive()) options.on_step(*scene_simulation.adaptive());
   const long total_steps = planned_steps(scene.solver);
-  ProgressBar progress(options.progress);
+  ProgressBar progress(options.progress, options.progress_file);
   try {
     while (!scene_simulation.finished()) {
       scene_simulation.advance();

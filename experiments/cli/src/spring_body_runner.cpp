@@ -216,7 +216,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   };
 
   write_frame();
-  ProgressBar progress(options.progress);
+  ProgressBar progress(options.progress, options.progress_file);
   try {
     while (!run->finished()) {
       run->advance();

@@ -19,8 +19,11 @@
 ///   - residual: ‖g_free‖ ≤ max(tolerance · force_scale, residual_floor);
 ///   - increment: a full Newton step (α = 1) with ‖Δq‖∞ ≤ increment_tolerance · displacement
 ///     scale, where the scale is ‖q − q_rest‖∞ (at least step_tolerance);
-///   - stall at round-off: the line search cannot lower E and the full step cannot lower ‖g‖, while
-///     ‖Δq‖∞ ≤ stall_tolerance · displacement scale — the residual is at its round-off level.
+///   - stall: the line search cannot lower E and the full step cannot lower ‖g‖, while
+///     ‖Δq‖∞ ≤ stall_tolerance · displacement scale (the residual is at its round-off level) or
+///     ‖g_free‖ ≤ stall_residual_tolerance · force_scale (the residual is small against the
+///     forces at work, e.g. on a symmetric path past a bifurcation, where the exact Hessian is
+///     indefinite and the projected one gives no further decrease).
 /// The last two are reported (`NewtonResult::criterion`) with the final residual.
 #include <string>
 #include <vector>
@@ -50,6 +53,10 @@ struct NewtonSettings {
   double increment_tolerance = 1e-9;
   /// Largest relative increment at which a stalled residual counts as converged.
   double stall_tolerance = 1e-7;
+  /// A stalled residual also counts as converged when ‖g_free‖ ≤ this × force_scale: far below
+  /// what engineering solvers accept (CalculiX's default is 5·10⁻³ of the mean force), at a point
+  /// where the line search can no longer resolve E.
+  double stall_residual_tolerance = 1e-5;
   /// Try the exact Hessian first (solvers that detect indefiniteness).
   bool exact_hessian = true;
   /// Rest positions q_rest (3·#Q) for the displacement scale; empty: the scale is ‖q‖∞.

@@ -112,7 +112,7 @@ struct SimulationCounters {
   long exact_hessian_iterations = 0;      ///< Newton iterations on the exact Hessian
   long projected_hessian_iterations = 0;  ///< … on the PSD-projected Hessian
   /// Newton solves (time or load steps) that converged on the increment, and that stopped at a
-  /// residual stalled at round-off (newton_solver.hpp); both are converged.
+  /// residual stalled (newton_solver.hpp); both are converged.
   long increment_converged_steps = 0;
   long stalled_steps = 0;
   /// Largest final ‖residual‖ / residual target over the Newton solves (≤ 1 unless a solve

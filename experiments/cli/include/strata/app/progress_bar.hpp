@@ -1,15 +1,20 @@
 #pragma once
 /// \file progress_bar.hpp
-/// A one-line progress bar with ETA on stderr, redrawn at most ~10 times per second.
+/// A one-line progress bar with ETA on stderr, redrawn at most ~10 times per second, and
+/// optionally the same progress as a small file for other programs (`strata run
+/// --progress-file`).
 #include <chrono>
+#include <filesystem>
 #include <string>
 
 namespace strata::app {
 
 class ProgressBar {
  public:
-  /// `enabled` false makes every call a no-op (use `stderr_is_terminal() && !quiet`).
-  explicit ProgressBar(bool enabled);
+  /// `enabled` false draws nothing (use `stderr_is_terminal() && !quiet`). A non-empty
+  /// `file` is rewritten at most twice a second with one line, "<fraction done> <seconds
+  /// elapsed>", whether or not the bar is drawn.
+  explicit ProgressBar(bool enabled, std::filesystem::path file = {});
   ~ProgressBar();
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;
@@ -20,10 +25,14 @@ class ProgressBar {
   void clear();
 
  private:
+  void write_file(double fraction, double elapsed);
+
   bool m_enabled;
   bool m_drawn = false;
+  std::filesystem::path m_file;
   std::chrono::steady_clock::time_point m_start;
   std::chrono::steady_clock::time_point m_last_draw;
+  std::chrono::steady_clock::time_point m_last_write;
 };
 
 /// Whether stderr is a terminal.

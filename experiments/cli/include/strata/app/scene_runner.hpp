@@ -35,7 +35,10 @@ struct RunOptions {
   std::filesystem::path output_dir;  ///< empty: default_output_dir(scene)
   bool quiet = false;                ///< no info lines and no summary (warnings still print)
   bool progress = false;             ///< draw a progress bar on stderr
-  std::ostream* log = nullptr;       ///< info and summary lines (nullptr: std::cout)
+  /// Non-empty: rewrite this file with "<fraction done> <seconds elapsed>" as the run goes
+  /// (at most twice a second), for a program that watches the run (experiment.py's ETA).
+  std::filesystem::path progress_file;
+  std::ostream* log = nullptr;  ///< info and summary lines (nullptr: std::cout)
   /// Scenes with a hierarchy: called with the run before the first step and after every step
   /// (e.g. to record the active cut, precompute_command.hpp).
   std::function<void(const AdaptiveSimulation&)> on_step;
