@@ -101,9 +101,12 @@ def values(mesh, field, faces, owner):
     fail(f"no field '{field}' in the frame (it has {', '.join(fields)})")
 
 
-LABELS = {"level": "active level", "von_mises": "von Mises stress [Pa]",
-          "plastic_strain": "equivalent plastic strain", "displacement": "displacement [m]",
-          "stress": "σ_xx [Pa]", "green_strain": "E_xx"}
+# In the scene's units (SI unless the scene chose others, e.g. mm for the armadillo scan).
+LABELS = {"level": "active level", "von_mises": "von Mises stress",
+          "plastic_strain": "equivalent plastic strain", "displacement": "displacement",
+          "stress": "σ_xx", "green_strain": "E_xx"}
+# Continuous fields: light at the low end, so that the shading shows the shape everywhere.
+CONTINUOUS = "YlOrRd"
 
 
 def positions(mesh, exaggerate):
@@ -177,7 +180,7 @@ def render(frames, fields, out, titles, view, exaggerate, up="z"):
             cmap = plt.get_cmap("viridis", int(hi - lo) + 1)
             norm = matplotlib.colors.Normalize(lo - 0.5, hi + 0.5)
         else:
-            cmap = plt.get_cmap("inferno")
+            cmap = plt.get_cmap(CONTINUOUS)
             norm = matplotlib.colors.Normalize(lo, hi if hi > lo else lo + 1e-30)
         for row, (mesh, (faces, _), v) in enumerate(zip(meshes, surfaces, per_frame)):
             axis = figure.add_subplot(len(frames), len(fields), row * len(fields) + column + 1,
@@ -225,7 +228,7 @@ def animate(pvd, field, out, fps, view, exaggerate, up="z"):
     surfaces = [boundary(m) for m in meshes]
     per_frame = [values(m, field, f, o) for m, (f, o) in zip(meshes, surfaces)]
     lo, hi = colour_range(per_frame, field == "level")
-    cmap = plt.get_cmap("viridis" if field == "level" else "inferno")
+    cmap = plt.get_cmap("viridis" if field == "level" else CONTINUOUS)
     norm = matplotlib.colors.Normalize(lo, hi if hi > lo else lo + 1e-30)
     figure = plt.figure(figsize=(5, 4))
     axis = figure.add_subplot(projection="3d")
