@@ -7,8 +7,10 @@
 Runs every spec's short version (experiment.py --quick --jobs 2), both stability maps on their
 coarse grids (stability_map.py --quick, over stiffness and over compression), then report.py on
 those results, and checks the report: a headline row and a section per spec, a table row per
-planned run, every chart and picture it links present and non-empty, and the stability section
-with both maps. Every run must finish with status ok, but for those named by --expect-failed,
+planned run, every chart and picture it links present and non-empty, each spec's
+error_vs_cost.png (and pictures.png when the spec asks for pictures, surface.png when its scene
+has a fine surface) among them, and the stability section with both maps. OUT is emptied first,
+so that no earlier run is reused. Every run must finish with status ok, but for those named by --expect-failed,
 which must not (e.g. block_compress/variant-stvk: StVK cannot hold the block compressed to a
 fifth of its height). Specs whose scene reads CGAL's models are skipped when the models are missing.
 """
@@ -16,6 +18,7 @@ import glob
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 
@@ -51,14 +54,22 @@ def main():
     specs = rest or sorted(glob.glob(os.path.join(REPO, "experiments", "specs", "*.json")))
     models = os.path.isdir(os.path.join(REPO, "build", "data", "models"))
     specs = [s for s in specs if models or not needs_models(s)]
+    shutil.rmtree(out, ignore_errors=True)
     results = os.path.join(out, "runs")
-    planned = {}
+    planned, wanted = {}, []
     for spec in specs:
         base = [sys.executable, os.path.join(HERE, "experiment.py"), spec, "--quick",
                 "--out", results, "--strata", strata, "--jobs", "2", "--threads", "1"]
         run(base)
         with open(spec) as f:
-            name = json.load(f).get("name", os.path.splitext(os.path.basename(spec))[0])
+            spec_json = json.load(f)
+        name = spec_json.get("name", os.path.splitext(os.path.basename(spec))[0])
+        wanted.append(f"{name}/error_vs_cost.png")
+        if "pictures" in spec_json:
+            wanted.append(f"{name}/pictures.png")
+            with open(os.path.join(os.path.dirname(spec), spec_json["scene"])) as f:
+                if "surface" in json.load(f).get("mesh", {}):
+                    wanted.append(f"{name}/surface.png")
         planned[name] = [line for line in run(base + ["--list"]).splitlines() if line.strip()]
         with open(os.path.join(results, name, "results.json")) as f:
             for row in json.load(f)["runs"]:
@@ -95,7 +106,7 @@ def main():
         path = os.path.join(report, link)
         if not os.path.exists(path) or os.path.getsize(path) < 1000:
             fail(f"the report links {link}, which is missing or empty")
-    for chart in ("stability_map.png", "stability_compression.png"):
+    for chart in wanted + ["stability_map.png", "stability_compression.png"]:
         if chart not in links:
             fail(f"the report does not show {chart}")
     print(f"check_report_smoke: {len(planned)} scenes, {len(links)} charts and pictures, "

@@ -18,6 +18,7 @@ mild compression (0.6 and above) with neo-Hookean, and no explicit run at 3x the
 """
 import csv
 import os
+import shutil
 import subprocess
 import sys
 
@@ -27,8 +28,11 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 def stiffness_problems(rows):
     problems = []
     for r in rows:
-        dt, estimate = float(r["dt"]), float(r["stable_dt_estimate"])
         label = f"{r['integrator']} {r['material']} E={r['youngs_modulus']} dt={r['dt']}"
+        if r["outcome"] == "failed":  # strata wrote no stats.json
+            problems.append(f"{label}: no result ({r['message']})")
+            continue
+        dt, estimate = float(r["dt"]), float(r["stable_dt_estimate"])
         if r["integrator"] == "implicit_euler" and r["outcome"] != "stable":
             problems.append(f"{label}: backward Euler {r['outcome']}")
         if r["integrator"] != "implicit_euler":
@@ -42,14 +46,19 @@ def stiffness_problems(rows):
 def compression_problems(rows):
     problems = []
     for r in rows:
+        if r["outcome"] == "failed":  # strata wrote no stats.json
+            problems.append(f"{r['integrator']} {r['material']} ratio={r['compression_ratio']} "
+                            f"dt={r['dt']}: no result ({r['message']})")
+            continue
         dt, estimate = float(r["dt"]), float(r["stable_dt_estimate"])
         ratio = float(r["compression_ratio"])
         label = f"{r['integrator']} {r['material']} ratio={r['compression_ratio']} dt={r['dt']}"
         implicit = r["integrator"] == "implicit_euler"
         if implicit and r["material"] == "neohookean" and r["outcome"] != "stable":
             problems.append(f"{label}: backward Euler neo-Hookean {r['outcome']}")
-        if r["material"] == "stvk" and ratio <= 0.4 and r["outcome"] == "stable":
-            problems.append(f"{label}: StVK stable under strong compression")
+        if r["material"] == "stvk" and ratio <= 0.4 and r["outcome"] not in ("inverted",
+                                                                             "diverged"):
+            problems.append(f"{label}: StVK {r['outcome']} under strong compression")
         if implicit and r["material"] == "stvk" and ratio >= 0.8 and r["outcome"] != "stable":
             problems.append(f"{label}: backward Euler StVK {r['outcome']} at mild compression")
         if not implicit:
@@ -66,6 +75,7 @@ def main():
     axis = "stiffness"
     if sys.argv[3:5] and sys.argv[3] == "--axis":
         axis = sys.argv[4]
+    shutil.rmtree(out, ignore_errors=True)  # no run of an earlier build is reused
     result = subprocess.run([sys.executable, os.path.join(HERE, "stability_map.py"), "--quick",
                              "--axis", axis, "--out", out, "--strata", strata, "--jobs", "2"],
                             capture_output=True, text=True)

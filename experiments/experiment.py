@@ -388,6 +388,10 @@ def execute(args, spec, name, settings, threads):
     except RuntimeError as error:
         return {"name": name, "settings": settings, "returncode": -1, "wall_seconds": 0.0,
                 "cpu_seconds": 0.0, "stderr": str(error)[-2000:]}
+    try:  # a killed earlier attempt's progress would show as this run's
+        os.remove(os.path.join(folder, PROGRESS_FILE))
+    except FileNotFoundError:
+        pass
     start = time.monotonic()
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     stderr_text = []
@@ -539,6 +543,12 @@ def summarise(args, spec):
                 "max_dofs": max(history.get("dofs") or [stats.get("dofs", 0)]),
                 "cut_changes": len(hierarchy.get("changes", [])),
                 "redone_steps": hierarchy.get("redone_steps", 0),
+                # time the hierarchy spent beside the steps on the cut: cut changes, redone
+                # steps, the initial adaptation
+                "cut_change_seconds": sum(c.get("seconds", 0.0)
+                                          for c in hierarchy.get("changes", [])),
+                "redo_seconds": hierarchy.get("redo_seconds", 0.0),
+                "initial_adaptation_seconds": hierarchy.get("initial_adaptation_seconds", 0.0),
                 "estimated_error": hierarchy.get("estimated_error"),
                 "tolerance_met": hierarchy.get("tolerance_met"),
                 "recorded_tolerance": hierarchy.get("precomputed", {}).get("recorded_tolerance"),
@@ -571,13 +581,14 @@ def summarise(args, spec):
     for row in rows:
         # Final elastic, kinetic and external-potential energies against the full run's, relative
         # to the full run's largest of the three.
-        if full is not None and full.get("final_energies") and row.get("final_energies"):
+        if (full is not None and full.get("final_energies") and row.get("final_energies")
+                and row["status"] == "ok"):
             reference = full["final_energies"]
             scale = max(abs(v) for v in reference.values())
             if scale > 0.0:
                 row["energy_difference"] = max(abs(row["final_energies"].get(k, 0.0) - v)
                                                for k, v in reference.items()) / scale
-        if full is not None and row.get("wall_seconds"):
+        if full is not None and row.get("wall_seconds") and row["status"] == "ok":
             row["speedup"] = full["wall_seconds"] / row["wall_seconds"]
         if row.get("error") and row.get("estimated_error") is not None and row["kind"] == "adaptive":
             row["effectivity"] = row["estimated_error"] / row["error"]
@@ -654,7 +665,8 @@ def write_results(args, spec, rows):
     for axis, cost, label in ((axes[0], "wall_seconds", "wall time [s]"),
                               (axes[1], "max_dofs", "largest active DOFs")):
         for kind, style in (("uniform", "s-"), ("adaptive", "o-")):
-            points = sorted((r[cost], max(r["error"], 1e-6), r) for r in ok if r["kind"] == kind)
+            points = sorted(((r[cost], max(r["error"], 1e-6), r) for r in ok if r["kind"] == kind),
+                            key=lambda p: (p[0], p[1]))
             if points:
                 axis.plot([p[0] for p in points], [p[1] for p in points], style, label=kind)
                 for x, y, r in points:
@@ -771,18 +783,21 @@ def main():
             # Each running run: its share done and ETA from strata's progress file; the sweep's
             # ETA: the running runs' ETAs plus the mean duration of a finished run for each run
             # not started, spread over the jobs.
-            shown, left_running = [], 0.0
+            # A run without an ETA yet (or no finished run to take a mean from) makes it "?";
+            # it is never below the longest running run's ETA.
+            shown, etas = [], []
             for name in sorted(running):
                 eta = run_eta(folders[name])
                 if eta is None:
                     shown.append(name)
                 else:
                     shown.append(f"{name} {100 * eta[0]:.0f} % ETA {eta[1]:.0f} s")
-                    left_running += eta[1]
+                    etas.append(eta[1])
             mean = sum(durations) / len(durations) if durations else None
             waiting = len(runs) - done - len(running)
-            if mean is not None or waiting == 0:
-                eta = f"{(left_running + (mean or 0.0) * waiting) / args.jobs:.0f} s"
+            if len(etas) == len(running) and (mean is not None or waiting == 0):
+                left = (sum(etas) + (mean or 0.0) * waiting) / args.jobs
+                eta = f"{max([left] + etas):.0f} s"
             else:
                 eta = "?"
             print(f"\rexperiment {spec['name']}: {done}/{len(runs)} done, running "
@@ -812,12 +827,17 @@ def main():
                     if running:
                         progress()
 
-        watcher = threading.Thread(target=ticker, daemon=True)
-        watcher.start()
-        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            list(pool.map(one, pending))
-        finished.set()
-        watcher.join()
+        # On a terminal only: in a log every redraw would be a line of its own.
+        watcher = threading.Thread(target=ticker, daemon=True) if sys.stderr.isatty() else None
+        if watcher is not None:
+            watcher.start()
+        try:
+            with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+                list(pool.map(one, pending))
+        finally:
+            finished.set()
+            if watcher is not None:
+                watcher.join()
         print(file=sys.stderr)
     if args.only:
         # One run of a spread sweep: the report is built once, with --report-only.

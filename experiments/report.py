@@ -99,28 +99,32 @@ def dominated(runs):
 
 def why_missed(runs, run):
     """A sentence from the sweep's own numbers on why `run` is not cheaper: how much of full
-    resolution its cut keeps, how much of its time it takes, how cautious its estimate is, and
-    whether any coarser uniform level is within 1 %."""
+    resolution its cut keeps, how much of its time it takes, how cautious its estimate is, how
+    much of its time went to cut changes, redone steps and the initial adaptation, and whether
+    any coarser uniform level is within 1 %."""
     full = next((r for r in runs if r["run"] == "full"), None)
     if full is None or not full.get("max_dofs") or not full.get("wall_seconds"):
         return ""
     dofs = run.get("max_dofs", 0) / full["max_dofs"]
     time = run["wall_seconds"] / full["wall_seconds"]
-    parts = [f"its largest cut keeps {100 * dofs:.0f} % of full resolution's DOFs and the run "
-             f"takes {100 * time:.0f} % of its wall time"]
+    mesh = "largest cut" if run["kind"] == "adaptive" else "mesh"
+    parts = [f"its {mesh} keeps {100 * dofs:.0f} % of full resolution's DOFs and the run takes "
+             f"{100 * time:.0f} % of its wall time"]
     if run.get("effectivity") is not None and run["effectivity"] > 2:
         parts.append(f"its estimate is {run['effectivity']:.1f}× the true error, so the cut is "
                      "finer than the tolerance needs")
-    if time > 1.3 * dofs:
-        parts.append("the rest of its time goes to cut changes, redone steps and the error "
-                     "estimate, beyond the solves on the smaller cut")
+    overhead = sum(run.get(k) or 0.0 for k in ("cut_change_seconds", "redo_seconds",
+                                                 "initial_adaptation_seconds"))
+    if run["kind"] == "adaptive" and run["wall_seconds"] > 0:
+        parts.append(f"cut changes, redone steps and the initial adaptation took "
+                     f"{100 * overhead / run['wall_seconds']:.0f} % of its time")
     uniform = [r for r in runs if r["kind"] == "uniform" and r["status"] == "ok"
                and r.get("error") is not None]
     if uniform and min(r["error"] for r in uniform) > 0.01:
         finest = max(uniform, key=lambda r: r.get("level", 0))
-        parts.append(f"no level below full resolution is within 1 % ({finest['run']}: "
-                     f"{percent(finest['error'])} off), so the scene needs the finest level over "
-                     "much of the body")
+        parts.append(f"no coarser uniform level is within 1 % ({finest['run']}: "
+                     f"{percent(finest['error'])} off): 1 % needs the finest level wherever the "
+                     "field varies")
     return "; ".join(parts) + "."
 
 
@@ -282,7 +286,8 @@ def main():
                            f"{percent(r.get('surface_error'))} | "
                            f"{percent(r.get('energy_difference'))} | "
                            f"{percent(r.get('estimated_error'))} | {effectivity} | ")
-            section[-1] += (f"{r['wall_seconds']:.2f} | {r.get('speedup', 0):.2f}× | "
+            speedup = f"{r['speedup']:.2f}×" if r.get("speedup") is not None else "–"
+            section[-1] += (f"{r['wall_seconds']:.2f} | {speedup} | "
                             f"{r.get('max_dofs', '–')} | {r.get('newton_iterations', '–')} | "
                             f"{r.get('linear_iterations', '–')} | {r.get('cut_changes', '–')} | "
                             f"{r.get('redone_steps', '–')} |")
@@ -295,8 +300,9 @@ def main():
             if r["status"] != "ok":
                 message = (r.get("message") or "").strip()
                 section.append(f"\n**{r['run']} did not finish** ({r['status']})" +
-                               (f": {message}" if message else "") + ". Its error covers no "
-                               "frame after the failure, so it is left out of the charts.")
+                               (f": {message}" if message else "") + ". It has no error "
+                               "against full resolution and no speed-up (its frames stop at the "
+                               "failure), and is left out of the charts.")
         for r in failed_cuts(runs):
             flagged = ("its own estimate flagged it (`tolerance_met: false`, a warning)"
                        if r.get("tolerance_met") is False else

@@ -7,13 +7,13 @@ or time step × compression.
 
 --axis stiffness (default) runs the scene (default: a 1 m cantilever of 20 × 2 × 2 cells under
 gravity, undamped, released from rest, 0.3 s) over Young's modulus E × time step dt; --axis
-compression runs a 0.1 m cube of 3 × 3 × 3 cells (E = 1 MPa, ν = 0.45, undamped) on a fixed base
-whose top face (clamped) is pushed down to a fraction of its height (the compression ratio: final height /
-rest height) over 0.2 s and held for 0.1 s, over compression ratio × dt. Every point runs for
-every integrator (symplectic_euler, rk4, implicit_euler) and material (stvk, neohookean) and is
-classified from its stats.json: stable (status ok), inverted (diverged with an inverted element,
-which StVK and corotated cannot handle) or diverged (blow-up, non-finite state or Newton
-failure). Writes OUT/stability.csv and OUT/stability_map.png (--axis compression:
+compression runs a 0.1 m cube of 3 × 3 × 3 cells (E = 1 MPa, ν = 0.45, undamped) on a fixed
+base whose clamped top face is pushed down to a fraction of its height (the compression ratio:
+final height / rest height) over 0.2 s and held for 0.1 s, over compression ratio × dt. Every
+point runs for every integrator (symplectic_euler, rk4, implicit_euler) and material (stvk,
+neohookean) and is classified from its stats.json: stable (status ok), inverted (diverged with
+an inverted element, which StVK and corotated cannot handle) or diverged (blow-up, non-finite
+state or Newton failure). Writes OUT/stability.csv and OUT/stability_map.png (--axis compression:
 OUT/stability_compression.csv and OUT/stability_compression.png): one panel per integrator and
 material, coloured by outcome, with the run's stable-step estimate (stats.json
 stable_dt_estimate, the element bound of the explicit integrators at rest) drawn as a line.
@@ -177,9 +177,14 @@ def main():
         for handle, label in zip(*axis.get_legend_handles_labels()):
             handles.setdefault(label, handle)
     figure.legend(handles.values(), handles.keys(), loc="lower center", ncol=len(handles))
-    figure.suptitle("Stability map: a cube compressed on its base (0.2 s, held 0.1 s; E = 1 MPa, ν = 0.45)"
-                    if compression else
-                    "Stability map: cantilever under gravity, released from rest (0.3 s)")
+    if args.scene is not None:
+        title = f"Stability map: {os.path.basename(args.scene)}"
+    elif compression:
+        title = ("Stability map: a cube compressed on its base (0.2 s, held 0.1 s; E = 1 MPa, "
+                 "ν = 0.45)")
+    else:
+        title = "Stability map: cantilever under gravity, released from rest (0.3 s)"
+    figure.suptitle(title)
     figure.tight_layout(rect=(0, 0.06, 1, 0.96))
     chart = os.path.join(args.out, "stability_compression.png" if compression
                          else "stability_map.png")

@@ -1,15 +1,20 @@
 // Newton on the static problem: quadratic convergence with the exact Hessian, fewer iterations
 // than with the PSD-projected Hessian alone, the increment criterion when the residual target is
-// out of reach, and the counters a Simulation reports.
+// out of reach, a stalled residual accepted only when small against the force scale, and the
+// counters a Simulation reports.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include "problem_test_utils.hpp"
 #include "strata/core/sim/energy/elastic_term.hpp"
+#include "strata/core/sim/energy/energy_term.hpp"
 #include "strata/core/sim/energy/external_work_term.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/static_solver.hpp"
@@ -116,6 +121,65 @@ TEST(Newton, UnreachableResidualConvergesOnTheIncrement) {
   EXPECT_LE(r.iterations, 15);
   EXPECT_LE((q - q_reference).lpNorm<Eigen::Infinity>(),
             1e-8 * std::abs(tip_deflection(c, q_reference)));
+}
+
+/// E = 0 with a gradient k (q − a) + δ (q − a)/‖q − a‖ of norm k‖q − a‖ + δ ≥ δ: Newton reaches
+/// q ≈ a, where no step can bring ‖g‖ below δ (a residual stalled at δ) and E cannot tell steps
+/// apart.
+class StalledGradientTerm final : public EnergyTerm {
+ public:
+  StalledGradientTerm(VectorXd a, double k, double delta)
+      : m_a(std::move(a)), m_k(k), m_delta(delta) {}
+  std::string_view name() const override { return "stalled"; }
+  double value(ConstRef<VectorXd>) const override { return 0.0; }
+  void add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const override {
+    const VectorXd d = q - m_a;
+    const double r = d.norm();
+    gradient += m_k * d;
+    if (r > 0.0)
+      gradient += m_delta / r * d;
+    else
+      gradient[0] += m_delta;  // at a itself: any direction, still of norm δ
+  }
+  void add_hessian(ConstRef<VectorXd>, SparseMatrixd& hessian, bool) const override {
+    add_diagonal(VectorXd::Constant(m_a.size(), m_k), hessian);
+  }
+
+ private:
+  VectorXd m_a;
+  double m_k, m_delta;
+};
+
+TEST(Newton, StalledResidualIsConvergedOnlyWhenSmallAgainstTheForceScale) {
+  const Cantilever c;
+  const double delta = 1e-6;  // the stalled residual [N]
+  const VectorXd& rest = c.model->rest_positions();
+  const VectorXd a = rest + VectorXd::Constant(rest.size(), 0.1);
+  const DofReduction reduction(c.embedded->stiffness_pattern(),
+                               std::vector<char>(static_cast<size_t>(rest.size()), 0));
+  for (const double force_scale : {1.0, 0.01}) {
+    EnergySum energy(c.embedded->stiffness_pattern());
+    energy.emplace<StalledGradientTerm>(a, 1.0, delta);
+    SpdSolver solver(LinearSolverKind::cholmod);
+    NewtonSettings settings;
+    settings.tolerance = 0.0;  // the residual criterion cannot be met
+    settings.residual_floor = 0.0;
+    settings.force_scale = force_scale;
+    settings.energy_scale = 1.0;
+    settings.rest_positions = &rest;
+    VectorXd q = rest;
+    const NewtonResult r = newton_minimize(energy, reduction, solver, settings, q);
+    // The last corrections (δ/k spread over the DOFs) stay far above round-off of the 0.1 m
+    // displacement, so only the residual's size against the force scale can make this converged.
+    EXPECT_NEAR(r.residual, delta, 1e-3 * delta) << "force scale " << force_scale;
+    EXPECT_LT(r.iterations, settings.max_iterations);
+    if (delta <= settings.stall_residual_tolerance * force_scale) {
+      EXPECT_TRUE(r.converged) << "force scale " << force_scale;
+      EXPECT_EQ(r.criterion, NewtonCriterion::stall);
+    } else {
+      EXPECT_FALSE(r.converged) << "force scale " << force_scale;
+    }
+  }
 }
 
 TEST(Newton, SimulationCountsHessianKindsAndCriteria) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <system_error>
 #include <utility>
 
 namespace strata::app {
@@ -41,9 +42,17 @@ ProgressBar::~ProgressBar() {
 }
 
 void ProgressBar::write_file(double fraction, double elapsed) {
-  // A reader may see the file truncated for a moment; it retries on its next poll.
-  std::ofstream out(m_file, std::ios::trunc);
-  if (out) out << fraction << ' ' << elapsed << '\n';
+  // Written beside and renamed over the file, so that a reader never sees it half-written.
+  std::filesystem::path part = m_file;
+  part += ".part";
+  {
+    std::ofstream out(part, std::ios::trunc);
+    if (!out) return;
+    out << fraction << ' ' << elapsed << '\n';
+    if (!out) return;
+  }
+  std::error_code error;
+  std::filesystem::rename(part, m_file, error);
 }
 
 void ProgressBar::update(double fraction, const std::string& label) {
