@@ -693,9 +693,11 @@ def write_results(args, spec, rows):
 
     adaptive = [r for r in ok if r["kind"] == "adaptive" and r.get("history")]
     if adaptive:
-        figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        figure, panels = plt.subplots(1, 3, figsize=(15, 4.2))
+        tets_axis, axes = panels[0], panels[1:]
         for r in adaptive:
             h = r["history"]
+            tets_axis.plot(h["time"], h["tets"], label=f"τ={r['tolerance']:g}")
             line, = axes[0].plot(h["time"], h["dofs"], label=f"τ={r['tolerance']:g}")
             # The refinement events: ▲ where a cut change refined, ▼ where it only coarsened.
             for marker, events in (("^", [c for c in h.get("changes", []) if c[2] > 0]),
@@ -708,12 +710,14 @@ def write_results(args, spec, rows):
                          color=line.get_color(), label=f"true, τ={r['tolerance']:g}")
             axes[1].plot(h["time"], [max(e, 1e-6) for e in h["estimated_error"]], "--",
                          color=line.get_color(), label=f"estimated, τ={r['tolerance']:g}")
+        tets_axis.set_xlabel("time [s] (static: load factor)")
+        tets_axis.set_ylabel("active tets")
         axes[0].set_xlabel("time [s] (static: load factor)")
         axes[0].set_ylabel("active DOFs (▲ refined, ▼ coarsened)")
         axes[1].set_xlabel("time [s] (static: load factor)")
         axes[1].set_ylabel("error")
         axes[1].set_yscale("log")
-        for axis in axes:
+        for axis in panels:
             axis.grid(True, alpha=0.3)
             axis.legend(fontsize=7)
         figure.suptitle(f"{spec['name']}: adaptive runs over time")
