@@ -23,6 +23,14 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// The mesh forces of `options` with every timed load at its peak.
+VectorXd peak_loads(const SimulationOptions& options) {
+  VectorXd forces = options.extra_mesh_forces;
+  for (const TimedForces& timed : options.extra_timed_mesh_forces)
+    forces += timed.amplitude.peak() * timed.forces;
+  return forces;
+}
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -208,37 +216,37 @@ AdaptiveSimulation::AdaptiveSimulation(
 void AdaptiveSimulation::initial_adaptation() {
   // Solve–mark–refine on the static response at full load, then start the dynamic run from rest
   // on the final cut. A static solve that fails (e.g. a load the body cannot carry statically)
-  // ends the adaptation on the cut reached so far.
+  // ends the adaptation on the cut reached so far. Between passes only the cut is flattened; the
+  // dynamic Simulation is built once, on the final cut.
   const auto start = Clock::now();
   SolverSettings statics = m_solver;
   statics.mode = SimulationMode::static_equilibrium;
   statics.load_steps = 1;
   // Only the pattern of the response matters here, not its last digits.
   statics.newton_tolerance = std::max(statics.newton_tolerance, 1e-6);
+  bool changed = false;  // m_constrained and m_mesh_external are ahead of m_simulation
   for (int pass = 0; pass < m_settings.max_passes && !all_at_level(*m_cut, max_refine_level());
        ++pass) {
-    const FlatTreeMesh& flat = m_constrained->flat;
-    const HangingConstraints& constraints = m_constrained->constraints;
-    SimulationOptions options;
-    options.vertex_embedding = constraints.matrix();
-    options.dof_vertices = constraints.free_vertices();
-    options.extra_mesh_forces =
-        m_mesh_external - gravity_forces(m_simulation->vertex_mass(), m_gravity);
-    options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
-    add_contact(options);
+    SimulationOptions options = flatten(0);
+    m_mesh_external = peak_loads(options);
+    options.extra_mesh_forces = m_mesh_external;
+    options.extra_timed_mesh_forces.clear();
     std::unique_ptr<Simulation> solve;
     try {
-      solve = std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet,
+      solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
                                            std::vector<RegionLoad>{}, m_ground, m_gravity, statics,
                                            std::move(options));
       solve->advance();
     } catch (const DivergenceError&) {
+      changed = true;
       break;
     }
+    m_mesh_external += gravity_forces(solve->vertex_mass(), m_gravity);
     const TetFields fields = solve->model().tet_fields(solve->positions());
     const VectorXd loads = criteria_loads(*solve);
-    CutState state{*m_tree,    flat, solve->positions(), fields, loads, solve->vertex_mass(),
-                   m_material, 0,    &m_load_traction};
+    CutState state{*m_tree,         m_constrained->flat,  solve->positions(), fields,
+                   loads,           solve->vertex_mass(), m_material,         0,
+                   &m_load_traction};
     state.solution_energy_scale = m_energy_floor;
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
@@ -250,8 +258,9 @@ void AdaptiveSimulation::initial_adaptation() {
     if (changes.refine.empty()) break;
     const CutChangeCounts counts = m_controller->apply(*m_cut, changes, 0);
     m_report.initial_refinements += static_cast<int>(counts.refined + counts.balance_refined);
-    rebuild(0);
+    changed = true;
   }
+  if (changed) rebuild(0);
   m_report.initial_adaptation_seconds = seconds_since(start);
   m_bookkeeping_seconds += m_report.initial_adaptation_seconds;
 }
@@ -335,7 +344,7 @@ bool AdaptiveSimulation::children_stable(NodeId n) const {
          m_solver.dt;
 }
 
-void AdaptiveSimulation::rebuild(long first_step) {
+SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   m_estimate_valid = false;
   m_constrained = std::make_unique<ConstrainedCut>(flatten_cut(*m_cut));
   const FlatTreeMesh& flat = m_constrained->flat;
@@ -347,18 +356,22 @@ void AdaptiveSimulation::rebuild(long first_step) {
   options.first_step = first_step;
   options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
   add_contact(options);
-  m_mesh_external = options.extra_mesh_forces;
   // The criteria see every load at its peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads) {
     VectorXd traction;
     VectorXd forces = map_point_loads(*m_cut, flat, point_loads, &traction);
     m_load_traction = m_load_traction.cwiseMax(amplitude.peak() * traction);
-    m_mesh_external += amplitude.peak() * forces;
     options.extra_timed_mesh_forces.push_back({amplitude, std::move(forces)});
   }
-  m_simulation =
-      std::make_unique<Simulation>(flat.mesh, m_material, m_dirichlet, std::vector<RegionLoad>{},
-                                   m_ground, m_gravity, m_solver, std::move(options));
+  return options;
+}
+
+void AdaptiveSimulation::rebuild(long first_step) {
+  SimulationOptions options = flatten(first_step);
+  m_mesh_external = peak_loads(options);
+  m_simulation = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
+                                              std::vector<RegionLoad>{}, m_ground, m_gravity,
+                                              m_solver, std::move(options));
   m_mesh_external += gravity_forces(m_simulation->vertex_mass(), m_gravity);
 }
 

@@ -17,6 +17,12 @@ double twice_energy_density(const Vector6d& e, const LameParameters& lame) {
   return 2.0 * lame.mu * contraction + lame.lambda * trace * trace;
 }
 
+/// The share of a level-ℓ tet's energy-norm error that refinement to the finest level L removes,
+/// in the measure of displacements: (1 − 2^−(L−ℓ)) · h_ℓ / h_0 (see the header).
+double displacement_share_removed(int depth, int level) {
+  return (1.0 - std::pow(2.0, -(depth - level))) * std::pow(2.0, -level);
+}
+
 }  // namespace
 
 RecoveryEstimate recovery_error_estimate(const CutState& state) {
@@ -53,9 +59,7 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
     }
     const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
     const int level = state.tree.level(state.flat.tet_nodes[t]);
-    // The part refinement to the finest level removes, in displacement: (1 − 2^−(L−ℓ)) of the
-    // energy error, times (h_ℓ / h_0)^½ = 2^−ℓ/2 (see the header).
-    const double removed = (1.0 - std::pow(2.0, -(depth - level))) * std::pow(2.0, -0.5 * level);
+    const double removed = displacement_share_removed(depth, level);
     estimate.element_error_sq[t] = error_sq * removed * removed;
     raw_total += error_sq;
     total += estimate.element_error_sq[t];
@@ -115,8 +119,7 @@ double RecoveryIndicator::merge_indicator(const CutState& state, const std::arra
   for (int k = 0; k < 8; ++k)
     loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
   const int depth = state.tree.max_level();
-  const double removed =
-      (1.0 - std::pow(2.0, -(depth - parent_level))) * std::pow(2.0, -0.5 * parent_level);
+  const double removed = displacement_share_removed(depth, parent_level);
   const double energy_tolerance = m_tolerance / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   return std::sqrt(loss * removed * removed / share);

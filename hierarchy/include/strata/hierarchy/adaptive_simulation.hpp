@@ -220,6 +220,10 @@ class AdaptiveSimulation final : public SimulationRun {
 
  private:
   void make_dirichlet_exact();
+  /// Flattens the cut (m_constrained) and maps the finest-level loads onto it (m_load_traction);
+  /// returns the options of a Simulation on it that starts at `first_step`.
+  SimulationOptions flatten(long first_step);
+  /// flatten() and a new Simulation on the cut; m_mesh_external follows.
   void rebuild(long first_step);
   bool adapt(int pass, bool refine, bool coarsen);
   /// Changes the cut by `changes` and moves the mesh-level state (x, v) of the current cut, with
