@@ -1,6 +1,10 @@
 // The process-wide thread policy: TBB follows the requested count; the BLAS and OpenMP libraries
-// behind CHOLMOD (when loaded) are set to their own count.
+// behind CHOLMOD (when loaded) are set to their own counts.
+#include <dlfcn.h>
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/common/parallel.hpp"
@@ -24,9 +28,36 @@ TEST(ThreadPolicy, SetsTbbAndBlasThreads) {
   EXPECT_LE(report.blas_threads, 1);
 }
 
+// CHOLMOD's supernodal factorisation opens OpenMP regions with a fixed num_threads(4) clause,
+// which omp_set_num_threads alone does not cap. Such a region, opened through libgomp's entry
+// point as compiled code opens it, must run on at most the policy's OpenMP threads.
+std::atomic<int> g_team_size{0};
+void record_team_size(void*) {
+  using Query = int (*)();
+  static const auto team_size = reinterpret_cast<Query>(dlsym(RTLD_DEFAULT, "omp_get_num_threads"));
+  g_team_size.store(std::max(g_team_size.load(), team_size()));
+}
+
+TEST(ThreadPolicy, CapsFixedSizeOpenMpRegions) {
+  using Parallel = void (*)(void (*)(void*), void*, unsigned, unsigned);
+  const auto parallel = reinterpret_cast<Parallel>(dlsym(RTLD_DEFAULT, "GOMP_parallel"));
+  if (parallel == nullptr || dlsym(RTLD_DEFAULT, "omp_get_num_threads") == nullptr)
+    GTEST_SKIP() << "libgomp is not loaded";
+  for (const int openmp : {1, 2}) {
+    const ThreadReport report = set_thread_policy({.threads = 2, .openmp_threads = openmp});
+    EXPECT_EQ(report.openmp_threads, openmp);
+    g_team_size = 0;
+    parallel(record_team_size, nullptr, 4, 0);
+    EXPECT_GE(g_team_size.load(), 1);
+    EXPECT_LE(g_team_size.load(), openmp);
+  }
+  set_thread_policy({});
+}
+
 TEST(ThreadPolicy, RejectsNegativeCounts) {
   EXPECT_THROW(set_thread_policy({.threads = -1}), InputError);
   EXPECT_THROW(set_thread_policy({.threads = 1, .blas_threads = -2}), InputError);
+  EXPECT_THROW(set_thread_policy({.threads = 1, .openmp_threads = -1}), InputError);
   set_thread_policy({});
 }
 

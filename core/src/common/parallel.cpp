@@ -55,17 +55,22 @@ int query_if_loaded(const char* name) {
 ThreadReport set_thread_policy(const ThreadPolicy& policy) {
   if (policy.threads < 0) throw InputError("threads: must be >= 0 (0 = every core)");
   if (policy.blas_threads < 0) throw InputError("blas threads: must be >= 0");
+  if (policy.openmp_threads < 0) throw InputError("openmp threads: must be >= 0");
   static std::unique_ptr<ThreadLimit> process_limit;
   const int threads = policy.threads > 0 ? policy.threads : available_cores();
   const int blas = policy.blas_threads > 0 ? policy.blas_threads : threads;
+  const int openmp = policy.openmp_threads > 0 ? policy.openmp_threads : threads;
   process_limit.reset();
   process_limit = std::make_unique<ThreadLimit>(threads);
   ThreadReport report;
   report.threads = max_threads();
   if (call_if_loaded("openblas_set_num_threads", blas))
     report.blas_threads = query_if_loaded("openblas_get_num_threads");
-  if (call_if_loaded("omp_set_num_threads", blas))
+  if (call_if_loaded("omp_set_num_threads", openmp)) {
+    // With dynamic adjustment a num_threads(k) clause is capped by the count above.
+    call_if_loaded("omp_set_dynamic", 1);
     report.openmp_threads = query_if_loaded("omp_get_max_threads");
+  }
   return report;
 }
 

@@ -30,7 +30,12 @@ int available_cores();
 
 struct ThreadPolicy {
   int threads = 0;       ///< TBB threads; 0 = available_cores()
-  int blas_threads = 1;  ///< OpenBLAS and OpenMP threads (0 = same as `threads`)
+  int blas_threads = 1;  ///< OpenBLAS threads (0 = same as `threads`)
+  /// OpenMP threads (0 = same as `threads`): CHOLMOD's supernodal factorisation runs OpenMP
+  /// regions while strata's TBB loops wait. Those regions ask for a fixed team of 4 threads; the
+  /// policy turns on OpenMP's dynamic adjustment, under which a region gets at most this many
+  /// (fewer when the machine is loaded), so they never oversubscribe the cores.
+  int openmp_threads = 0;
 };
 
 /// What the policy set. A library that is not loaded (or not OpenBLAS / not OpenMP) reports 0.

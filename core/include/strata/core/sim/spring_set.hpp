@@ -24,6 +24,12 @@ struct SpringSet {
   void add_hessian(ConstRef<VectorXd> x, SparseMatrixd& hessian, bool project_psd) const;
   /// The 3×3 blocks (a, a), (a, b), (b, a), (b, b) of every spring as zero triplets, for a pattern.
   void add_pattern(std::vector<Eigen::Triplet<double>>& triplets) const;
+
+ private:
+  /// Value offsets of every spring's 36 Hessian entries in the last pattern add_hessian saw
+  /// (found by binary search once per pattern, checked against its row indices on every use).
+  mutable std::vector<int> m_offsets;
+  bool locate(const SparseMatrixd& hessian) const;
 };
 
 }  // namespace strata
