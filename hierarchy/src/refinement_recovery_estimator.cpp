@@ -18,9 +18,9 @@ double twice_energy_density(const Vector6d& e, const LameParameters& lame) {
 }
 
 /// The share of a level-ℓ tet's energy-norm error that refinement to the finest level L removes,
-/// in the measure of displacements: (1 − 2^−(L−ℓ)) · h_ℓ / h_0 (see the header).
+/// in the measure of displacements: (1 − 2^−(L−ℓ)) · (h_ℓ / h_0)^½ (see the header).
 double displacement_share_removed(int depth, int level) {
-  return (1.0 - std::pow(2.0, -(depth - level))) * std::pow(2.0, -level);
+  return (1.0 - std::pow(2.0, -(depth - level))) * std::pow(2.0, -0.5 * level);
 }
 
 }  // namespace
