@@ -539,6 +539,8 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   // previous Simulation in place and marks the driver failed.
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
   std::unique_ptr<Simulation> old_simulation = std::move(m_simulation);
+  VectorXd old_mesh_external = m_mesh_external;
+  VectorXd old_load_traction = m_load_traction;
   try {
     rebuild(first_step);
     const FlatTreeMesh& new_flat = m_constrained->flat;
@@ -555,6 +557,8 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   } catch (...) {
     m_constrained = std::move(old_cut);
     m_simulation = std::move(old_simulation);
+    m_mesh_external = std::move(old_mesh_external);
+    m_load_traction = std::move(old_load_traction);
     m_failed = true;
     throw;
   }

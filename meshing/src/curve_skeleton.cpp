@@ -56,17 +56,21 @@ CurveSkeleton curve_skeleton(const SurfaceMesh& surface, const std::string& wher
     throw InputError(where + ": the surface has holes (a skeleton needs a closed surface)");
   if (!CGAL::is_triangle_mesh(mesh)) throw InputError(where + ": not a triangle mesh");
   Skeleton skeleton;
-  try {
+  {
     // Address space for the skeletonization's copy of the surface and its Delaunay poles; pages
     // are committed only as they are used.
     detail::MonotoneArena arena(kArenaBase + kArenaPerVertex * surface.vertices.rows());
-    CGAL::extract_mean_curvature_flow_skeleton(mesh, skeleton);
-  } catch (const std::bad_alloc&) {
-    throw InputError(
-        where + ": skeletonization ran out of memory (its arena holds " +
-        std::to_string((kArenaBase + kArenaPerVertex * surface.vertices.rows()) >> 20) + " MiB)");
-  } catch (const std::exception& error) {
-    throw InputError(where + ": skeletonization failed: " + error.what());
+    try {
+      CGAL::extract_mean_curvature_flow_skeleton(mesh, skeleton);
+    } catch (const std::bad_alloc&) {
+      const bool arena_full = arena.reserved() && arena.used() + (1u << 20) > arena.capacity();
+      throw InputError(
+          where + ": skeletonization ran out of memory" +
+          (arena_full ? " (its arena of " + std::to_string(arena.capacity() >> 20) + " MiB is full)"
+                      : std::string()));
+    } catch (const std::exception& error) {
+      throw InputError(where + ": skeletonization failed: " + error.what());
+    }
   }
   CurveSkeleton result;
   const auto count = static_cast<Index>(boost::num_vertices(skeleton));

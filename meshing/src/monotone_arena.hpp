@@ -10,7 +10,8 @@
 /// Include this before any CGAL header and define CGAL_ALLOCATOR(T) as
 /// strata::detail::MonotoneAllocator<T>; while a MonotoneArena is alive on a thread, the CGAL
 /// containers that thread creates draw from it (freed memory is not reused until the arena ends).
-/// Outside an arena the allocator is std::allocator.
+/// Outside an arena the allocator is std::allocator. Arenas do not nest, and one that cannot
+/// reserve its address space is inactive (std::allocator, no address order).
 #include <sys/mman.h>
 
 #include <cstddef>
@@ -43,8 +44,8 @@ class MonotoneArena {
   MonotoneArena& operator=(const MonotoneArena&) = delete;
 
   void* allocate(std::size_t bytes, std::size_t alignment) {
-    std::size_t start = (m_used + alignment - 1) / alignment * alignment;
-    if (start + bytes > m_capacity) throw std::bad_alloc();
+    const std::size_t start = (m_used + alignment - 1) / alignment * alignment;
+    if (start > m_capacity || bytes > m_capacity - start) throw std::bad_alloc();
     m_used = start + bytes;
     return m_base + start;
   }
@@ -53,6 +54,7 @@ class MonotoneArena {
     return c >= m_base && c < m_base + m_capacity;
   }
   std::size_t used() const { return m_used; }
+  std::size_t capacity() const { return m_capacity; }
 
   /// The arena of this thread, if one is alive.
   static MonotoneArena* active() { return s_active; }
@@ -77,8 +79,10 @@ struct MonotoneAllocator {
   MonotoneAllocator(const MonotoneAllocator<U>&) {}
 
   T* allocate(std::size_t n) {
-    if (MonotoneArena* arena = MonotoneArena::active())
+    if (MonotoneArena* arena = MonotoneArena::active()) {
+      if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_alloc();
       return static_cast<T*>(arena->allocate(n * sizeof(T), alignof(T)));
+    }
     return std::allocator<T>().allocate(n);
   }
   void deallocate(T* p, std::size_t n) {
@@ -96,8 +100,15 @@ struct MonotoneAllocator {
   void destroy(U* p) {
     p->~U();
   }
-  friend bool operator==(const MonotoneAllocator&, const MonotoneAllocator&) { return true; }
-  friend bool operator!=(const MonotoneAllocator&, const MonotoneAllocator&) { return false; }
 };
+
+template <class T, class U>
+bool operator==(const MonotoneAllocator<T>&, const MonotoneAllocator<U>&) {
+  return true;
+}
+template <class T, class U>
+bool operator!=(const MonotoneAllocator<T>&, const MonotoneAllocator<U>&) {
+  return false;
+}
 
 }  // namespace strata::detail

@@ -64,13 +64,13 @@ ThreadReport set_thread_policy(const ThreadPolicy& policy) {
   process_limit = std::make_unique<ThreadLimit>(threads);
   ThreadReport report;
   report.threads = max_threads();
+  // OpenMP first: an OpenBLAS built on OpenMP sets the OpenMP count itself, and must keep its own.
+  const bool has_openmp = call_if_loaded("omp_set_num_threads", openmp);
+  // With dynamic adjustment libgomp caps a num_threads(k) clause by the count above.
+  if (has_openmp) call_if_loaded("omp_set_dynamic", 1);
   if (call_if_loaded("openblas_set_num_threads", blas))
     report.blas_threads = query_if_loaded("openblas_get_num_threads");
-  if (call_if_loaded("omp_set_num_threads", openmp)) {
-    // With dynamic adjustment a num_threads(k) clause is capped by the count above.
-    call_if_loaded("omp_set_dynamic", 1);
-    report.openmp_threads = query_if_loaded("omp_get_max_threads");
-  }
+  if (has_openmp) report.openmp_threads = query_if_loaded("omp_get_max_threads");
   return report;
 }
 

@@ -3,8 +3,10 @@
 /// Thread control. strata's own loops run on TBB; the BLAS behind CHOLMOD (OpenBLAS) and OpenMP
 /// start threads of their own. On few cores these oversubscribe them: BLAS and OpenMP threads
 /// spin-wait while TBB's workers run and the reverse, which shows as system time. One process-wide
-/// policy (`set_thread_policy`) sets all three: TBB to N threads, BLAS and OpenMP to
-/// `ThreadPolicy::blas_threads` (default 1, so the sparse factorisation does not compete with TBB).
+/// policy (`set_thread_policy`) sets all three: TBB to N threads, OpenBLAS to
+/// `ThreadPolicy::blas_threads` (default 1) and OpenMP to `ThreadPolicy::openmp_threads` (default
+/// N) with dynamic adjustment. OpenMP's settings belong to the thread that applies the policy (in
+/// libgomp they are per thread): sparse solves run on that thread, as they do in the CLI.
 #include <memory>
 
 namespace strata {

@@ -28,6 +28,7 @@ struct SpringSet {
  private:
   /// Value offsets of every spring's 36 Hessian entries in the last pattern add_hessian saw
   /// (found by binary search once per pattern, checked against its row indices on every use).
+  /// A cache behind a const method: one SpringSet's add_hessian is not called concurrently.
   mutable std::vector<int> m_offsets;
   bool locate(const SparseMatrixd& hessian) const;
 };
