@@ -34,9 +34,9 @@ struct ThreadPolicy {
   int threads = 0;       ///< TBB threads; 0 = available_cores()
   int blas_threads = 1;  ///< OpenBLAS threads (0 = same as `threads`)
   /// OpenMP threads (0 = same as `threads`): CHOLMOD's supernodal factorisation runs OpenMP
-  /// regions while strata's TBB loops wait. Those regions ask for a fixed team of 4 threads; the
-  /// policy turns on OpenMP's dynamic adjustment, under which a region gets at most this many
-  /// (fewer when the machine is loaded), so they never oversubscribe the cores.
+  /// regions while strata's TBB loops wait. They ran with a team of 4 threads on 2 cores, a fixed
+  /// request that omp_set_num_threads alone does not cap; the policy turns on OpenMP's dynamic
+  /// adjustment, under which a region gets at most this many (fewer when the machine is loaded).
   int openmp_threads = 0;
 };
 
