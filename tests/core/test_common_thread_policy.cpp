@@ -28,9 +28,9 @@ TEST(ThreadPolicy, SetsTbbAndBlasThreads) {
   EXPECT_LE(report.blas_threads, 1);
 }
 
-// CHOLMOD's supernodal factorisation opens OpenMP regions with a fixed num_threads(4) clause,
-// which omp_set_num_threads alone does not cap. Such a region, opened through libgomp's entry
-// point as compiled code opens it, must run on at most the policy's OpenMP threads.
+// CHOLMOD's supernodal factorisation opens OpenMP regions with a fixed team size (4 threads were
+// seen on 2 cores), which omp_set_num_threads alone does not cap. Such a region, opened through
+// libgomp's entry point as compiled code opens it, must run on at most the policy's OpenMP threads.
 std::atomic<int> g_team_size{0};
 void record_team_size(void*) {
   using Query = int (*)();
