@@ -14,9 +14,8 @@
 #include "strata/hierarchy/cut_state.hpp"
 #include "strata/hierarchy/cut_transfer.hpp"
 #include "strata/hierarchy/red_refinement.hpp"
-#include "strata/hierarchy/refinement_force_indicator.hpp"
+#include "strata/hierarchy/refinement_indicator_registry.hpp"
 #include "strata/hierarchy/refinement_recovery_estimator.hpp"
-#include "strata/hierarchy/refinement_stress_jump_indicator.hpp"
 
 namespace strata {
 namespace {
@@ -41,14 +40,6 @@ bool is_static(const SolverSettings& settings) {
 
 bool is_explicit(const SolverSettings& settings) {
   return !is_static(settings) && settings.integrator != Integrator::implicit_euler;
-}
-
-std::unique_ptr<RefinementIndicator> make_indicator(const HierarchySettings& settings) {
-  if (settings.indicator == "recovery")
-    return std::make_unique<RecoveryIndicator>(settings.tolerance);
-  if (settings.indicator == "stress_jump")
-    return std::make_unique<StressJumpIndicator>(settings.criteria.stress_floor);
-  return std::make_unique<ForceIndicator>(settings.criteria.stress_floor);
 }
 
 /// Whether every active tet is at `max_level` (nothing left to refine).
@@ -115,11 +106,7 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
                      " (levels), got " + std::to_string(settings.level));
   if (settings.adapt_every < 1) throw InputError(where + ".adapt_every: must be >= 1");
   if (settings.max_passes < 1) throw InputError(where + ".max_passes: must be >= 1");
-  if (settings.indicator != "recovery" && settings.indicator != "force" &&
-      settings.indicator != "stress_jump")
-    throw InputError(where +
-                     ".indicator: expected \"recovery\", \"force\" or \"stress_jump\", got \"" +
-                     settings.indicator + "\"");
+  refinement_indicator_traits(settings.indicator, where + ".indicator");
   if (!(settings.tolerance > 0.0 && settings.tolerance < 1.0))
     throw InputError(where + ".tolerance: must be in (0, 1)");
   validate_refinement_settings(settings.criteria, where);
@@ -171,11 +158,14 @@ AdaptiveSimulation::AdaptiveSimulation(
     m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, start_level));
   }
   m_locator = std::make_unique<TreePointLocator>(*m_tree);
-  if (m_settings.indicator == "recovery" && !m_settings.refine_threshold_set)
+  const RefinementIndicatorTraits& indicator =
+      refinement_indicator_traits(m_settings.indicator, "hierarchy.indicator");
+  m_estimates_error = indicator.estimates_error;
+  if (m_estimates_error && !m_settings.refine_threshold_set)
     m_settings.criteria.refine_threshold = 1.0;  // a tet's equidistributed share of the tolerance
   m_report.tolerance = m_settings.tolerance;
-  m_controller =
-      std::make_unique<RefinementController>(m_settings.criteria, make_indicator(m_settings));
+  m_controller = std::make_unique<RefinementController>(
+      m_settings.criteria, indicator.make(m_settings.tolerance, m_settings.criteria));
   if (is_explicit(m_solver)) {
     if (m_settings.criteria.balance)
       throw InputError(
@@ -250,8 +240,7 @@ void AdaptiveSimulation::initial_adaptation() {
     state.solution_energy_scale = m_energy_floor;
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
-    if (m_settings.indicator == "recovery" && estimate.relative_error <= m_settings.tolerance)
-      break;
+    if (m_estimates_error && estimate.relative_error <= m_settings.tolerance) break;
     CutChanges changes = m_controller->decide(state, *m_cut);
     changes.coarsen.clear();
     m_report.refused_refinements += changes.refused;
@@ -483,9 +472,9 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
   state.recovery_estimate = &m_estimate;
-  // The recovery criterion refines only while the run's estimate exceeds the tolerance.
+  // An error-estimating indicator refines only while the run's estimate exceeds the tolerance.
   const bool within_tolerance =
-      m_settings.indicator == "recovery" && m_estimate.relative_error <= m_settings.tolerance;
+      m_estimates_error && m_estimate.relative_error <= m_settings.tolerance;
   if (!coarsen && (!refine || within_tolerance)) return {};
   CutChanges changes = m_controller->decide(state, *m_cut);
   if (!refine || within_tolerance) {

@@ -3,14 +3,22 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <random>
+#include <vector>
 
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/material.hpp"
+#include "strata/core/fem/material_registry.hpp"
 
 namespace strata::testing {
 
-inline constexpr std::array<MaterialModel, 3> kAllModels = {
-    MaterialModel::stvk, MaterialModel::corotated, MaterialModel::neohookean};
+/// Every registered model (material_registry.hpp).
+inline std::vector<MaterialModel> all_models() {
+  std::vector<MaterialModel> models;
+  for (const MaterialModelTraits& traits : material_registry())
+    models.push_back(traits.model);
+  return models;
+}
+inline const std::vector<MaterialModel> kAllModels = all_models();
 
 inline LameParameters test_lame() {
   return lame_parameters(1.0e6, 0.3);

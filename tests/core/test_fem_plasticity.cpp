@@ -180,9 +180,7 @@ TEST_P(UniaxialPlateau, PerfectPlasticityHoldsTheYieldStress) {
     EXPECT_NEAR(sim.plastic_state().equivalent_strain[t], expected, 0.02 * expected);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllModels, UniaxialPlateau,
-                         ::testing::Values(MaterialModel::stvk, MaterialModel::corotated,
-                                           MaterialModel::neohookean),
+INSTANTIATE_TEST_SUITE_P(AllModels, UniaxialPlateau, ::testing::ValuesIn(testing::kAllModels),
                          [](const auto& info) { return to_string(info.param); });
 
 /// The bar pulled by a total force P·s(λ) on its end face, loaded and unloaded by the amplitude.

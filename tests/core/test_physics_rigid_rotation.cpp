@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include "fem_test_utils.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/simulation.hpp"
 
@@ -45,9 +46,7 @@ TEST_P(RigidRotation, EndFaceRotationMovesTheBodyRigidly) {
   EXPECT_LT(sim.reactions()[0].force.norm(), 1e-6);
 }
 
-INSTANTIATE_TEST_SUITE_P(SimPhysics, RigidRotation,
-                         ::testing::Values(MaterialModel::stvk, MaterialModel::corotated,
-                                           MaterialModel::neohookean),
+INSTANTIATE_TEST_SUITE_P(SimPhysics, RigidRotation, ::testing::ValuesIn(testing::kAllModels),
                          [](const auto& info) { return to_string(info.param); });
 
 }  // namespace

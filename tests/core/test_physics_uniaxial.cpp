@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "fem_test_utils.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/simulation.hpp"
 
@@ -75,9 +76,7 @@ TEST_P(UniaxialTension, PoissonRatioAndYoungsModulusAreRecovered) {
   EXPECT_LT(total.norm(), 1e-6 * std::abs(reactions[3].force.x()));
 }
 
-INSTANTIATE_TEST_SUITE_P(SimPhysics, UniaxialTension,
-                         ::testing::Values(MaterialModel::stvk, MaterialModel::corotated,
-                                           MaterialModel::neohookean),
+INSTANTIATE_TEST_SUITE_P(SimPhysics, UniaxialTension, ::testing::ValuesIn(testing::kAllModels),
                          [](const auto& info) { return to_string(info.param); });
 
 }  // namespace

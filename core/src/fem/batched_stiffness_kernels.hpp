@@ -1,10 +1,45 @@
 #pragma once
-// Internal to elastic_model.cpp: the StVK element stiffness of kLanes tets at once in
-// structure-of-arrays form (vectorised across tets, like batched_stress_kernels.hpp), and its
-// scatter into the values of the fixed sparsity pattern.
+// Internal to elastic_model.cpp: the StVK element stiffness in closed form, of one tet and of
+// kLanes tets at once in structure-of-arrays form (vectorised across tets, like
+// batched_stress_kernels.hpp), and its scatter into the values of the fixed sparsity pattern.
 #include "batched_stress_kernels.hpp"
+#include "strata/core/fem/stvk.hpp"
 
 namespace strata::detail {
+
+/// StVK element stiffness in closed form, block (b, a) = ∂²W/∂x_b∂x_a:
+/// V [(g_aᵀ S g_b) I + λ (F g_b)(F g_a)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_a)(F g_b)ᵀ], g_k = ∇N_k.
+/// Plain scalar arrays on purpose: mixing Eigen's packed 3 × 3 temporaries with scalar diagonal
+/// updates caused store-forwarding stalls that took half of the assembly time.
+inline void stvk_stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double, 4, 3>& grad_N,
+                                  const LameParameters& lame, double volume,
+                                  Matrix3d (&blocks)[4][4]) {
+  const Matrix3d S = second_piola_stvk(F, lame);
+  double Fg[4][3], Sg[4][3], FFt[3][3];
+  for (int k = 0; k < 4; ++k)
+    for (int r = 0; r < 3; ++r) {
+      Fg[k][r] = F(r, 0) * grad_N(k, 0) + F(r, 1) * grad_N(k, 1) + F(r, 2) * grad_N(k, 2);
+      Sg[k][r] = S(r, 0) * grad_N(k, 0) + S(r, 1) * grad_N(k, 1) + S(r, 2) * grad_N(k, 2);
+    }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      FFt[r][c] = F(r, 0) * F(c, 0) + F(r, 1) * F(c, 1) + F(r, 2) * F(c, 2);
+  const double lambda = volume * lame.lambda, mu = volume * lame.mu;
+  for (int b = 0; b < 4; ++b)
+    for (int a = b; a < 4; ++a) {
+      const double geometric =
+          volume * (grad_N(a, 0) * Sg[b][0] + grad_N(a, 1) * Sg[b][1] + grad_N(a, 2) * Sg[b][2]);
+      const double gg = mu * (grad_N(a, 0) * grad_N(b, 0) + grad_N(a, 1) * grad_N(b, 1) +
+                              grad_N(a, 2) * grad_N(b, 2));
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          const double value = lambda * Fg[b][r] * Fg[a][c] + mu * Fg[a][r] * Fg[b][c] +
+                               gg * FFt[r][c] + (r == c ? geometric : 0.0);
+          blocks[b][a](r, c) = value;
+          blocks[a][b](c, r) = value;
+        }
+    }
+}
 
 /// StVK element stiffness of each lane l, 12 × 12 column-major: K[l][3b + c][3a + r] = K_ab(r, c),
 /// K_ab = V [(g_aᵀ S g_b) I + λ (F g_a)(F g_b)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_b)(F g_a)ᵀ],

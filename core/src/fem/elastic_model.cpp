@@ -11,6 +11,7 @@
 
 #include "batched_stiffness_kernels.hpp"
 #include "batched_stress_kernels.hpp"
+#include "material_models.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/fem/deformation_gradient.hpp"
 #include "strata/core/fem/green_strain.hpp"
@@ -23,35 +24,20 @@ namespace strata {
 
 namespace {
 
-// Element kernels: first Piola stress (and energy density) of one model, inlined in the loops.
-struct StvkKernel {
-  using LaneKernel = detail::StvkLanes;
+// Element kernel of one model (material_models.hpp): its first Piola stress and energy density at
+// the run's Lamé parameters, inlined in the loops; the model's LaneKernel, if any, comes with it.
+template <typename Model>
+struct ModelKernel : Model {
   LameParameters lame;
-  Matrix3d P(const Matrix3d& F) const { return dpsi_stvk_dF(F, lame); }
-  double psi(const Matrix3d& F) const { return psi_stvk(F, lame); }
-};
-struct CorotatedKernel {
-  LameParameters lame;
-  Matrix3d P(const Matrix3d& F) const { return dpsi_corotated_dF(F, lame); }
-  double psi(const Matrix3d& F) const { return psi_corotated(F, lame); }
-};
-struct NeoHookeanKernel {
-  using LaneKernel = detail::NeoHookeanLanes;
-  LameParameters lame;
-  Matrix3d P(const Matrix3d& F) const { return dpsi_neohookean_dF(F, lame); }
-  double psi(const Matrix3d& F) const { return psi_neohookean(F, lame); }
+  explicit ModelKernel(const LameParameters& l) : lame(l) {}
+  Matrix3d P(const Matrix3d& F) const { return Model::first_piola(F, lame); }
+  double psi(const Matrix3d& F) const { return Model::energy_density(F, lame); }
 };
 
 template <typename Body>
 void dispatch_kernel(MaterialModel model, const LameParameters& lame, Body&& body) {
-  switch (model) {
-    case MaterialModel::stvk:
-      return body(StvkKernel{lame});
-    case MaterialModel::corotated:
-      return body(CorotatedKernel{lame});
-    case MaterialModel::neohookean:
-      return body(NeoHookeanKernel{lame});
-  }
+  detail::visit_material_model(
+      model, [&](auto model_type) { body(ModelKernel<decltype(model_type)>(lame)); });
 }
 
 inline Matrix3d edge_matrix_at(const double* x, const int* tet) {
@@ -310,39 +296,6 @@ void ElasticModel::build_stiffness_pattern() {
 
 namespace {
 
-/// StVK element stiffness in closed form, block (b, a) = ∂²W/∂x_b∂x_a:
-/// V [(g_aᵀ S g_b) I + λ (F g_b)(F g_a)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_a)(F g_b)ᵀ], g_k = ∇N_k.
-/// Plain scalar arrays on purpose: mixing Eigen's packed 3 × 3 temporaries with scalar diagonal
-/// updates caused store-forwarding stalls that took half of the assembly time.
-void stvk_stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double, 4, 3>& grad_N,
-                           const LameParameters& lame, double volume, Matrix3d (&blocks)[4][4]) {
-  const Matrix3d S = second_piola_stvk(F, lame);
-  double Fg[4][3], Sg[4][3], FFt[3][3];
-  for (int k = 0; k < 4; ++k)
-    for (int r = 0; r < 3; ++r) {
-      Fg[k][r] = F(r, 0) * grad_N(k, 0) + F(r, 1) * grad_N(k, 1) + F(r, 2) * grad_N(k, 2);
-      Sg[k][r] = S(r, 0) * grad_N(k, 0) + S(r, 1) * grad_N(k, 1) + S(r, 2) * grad_N(k, 2);
-    }
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      FFt[r][c] = F(r, 0) * F(c, 0) + F(r, 1) * F(c, 1) + F(r, 2) * F(c, 2);
-  const double lambda = volume * lame.lambda, mu = volume * lame.mu;
-  for (int b = 0; b < 4; ++b)
-    for (int a = b; a < 4; ++a) {
-      const double geometric =
-          volume * (grad_N(a, 0) * Sg[b][0] + grad_N(a, 1) * Sg[b][1] + grad_N(a, 2) * Sg[b][2]);
-      const double gg = mu * (grad_N(a, 0) * grad_N(b, 0) + grad_N(a, 1) * grad_N(b, 1) +
-                              grad_N(a, 2) * grad_N(b, 2));
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
-          const double value = lambda * Fg[b][r] * Fg[a][c] + mu * Fg[a][r] * Fg[b][c] +
-                               gg * FFt[r][c] + (r == c ? geometric : 0.0);
-          blocks[b][a](r, c) = value;
-          blocks[a][b](c, r) = value;
-        }
-    }
-}
-
 /// Element stiffness blocks from the generic ∂²ψ/∂F²:
 /// K_ab = V Σ_{c,d} ∇N_a[c] ∇N_b[d] · (∂²ψ/∂F_{·c}∂F_{·d}). Plain arrays, as for StVK.
 void generic_stiffness_blocks(const Matrix9d& d2psi, const Eigen::Matrix<double, 4, 3>& grad_N,
@@ -378,50 +331,73 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
   else
     std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
   double* values = K.valuePtr();
-  const bool closed_form_stvk = m_material.model == MaterialModel::stvk && !project_psd;
-  for_each_chunk_colored(m_partition, [&](int chunk) {
-    int i = m_partition.chunk_begin[chunk];
-    const int end = m_partition.chunk_begin[chunk + 1];
-    if (closed_form_stvk) {
-      using detail::kLanes;
-      const detail::StvkStiffnessLanes lanes(m_lame);
-      double lane_K[kLanes][12][12];
-      for (; i + kLanes <= end; i += kLanes) {
-        const double* lane_Dm_inv = &m_lane_rest[kLaneRest * (i / kLanes)];
-        // The value array is far larger than the caches: fetch the next group's entries while
-        // this group's blocks are computed.
-        if (i + 2 * kLanes <= end)
-          detail::prefetch_block_entries(&m_block_offsets[48 * (i + kLanes)], values);
-        double F[3][3][kLanes];
-        detail::lane_deformation_gradient(x.data(), &m_sorted_tets[4 * i], lane_Dm_inv, F);
-        lanes(F, lane_Dm_inv, lane_Dm_inv + 9 * kLanes, lane_K);
-        for (int l = 0; l < kLanes; ++l)
-          detail::scatter_element_stiffness(lane_K[l], &m_block_offsets[48 * (i + l)], values);
-      }
-    }
-    Matrix3d blocks[4][4];
-    for (; i < end; ++i) {
-      const int* tet = &m_sorted_tets[4 * i];
-      const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
-      const Matrix3d F = edge_matrix_at(x.data(), tet) * Dm_inv;
-      const Eigen::Matrix<double, 4, 3> grad_N = shape_function_gradients(Dm_inv);
-      if (closed_form_stvk) {
-        stvk_stiffness_blocks(F, grad_N, m_lame, m_sorted_volume[i], blocks);
-      } else {
-        const Matrix9d d2psi = project_psd ? d2psi_dF2_psd(m_material.model, F, m_lame)
-                                           : d2psi_dF2(m_material.model, F, m_lame);
-        generic_stiffness_blocks(d2psi, grad_N, m_sorted_volume[i], blocks);
-      }
-      const int* offsets = &m_block_offsets[48 * i];
-      for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-          for (int c = 0; c < 3; ++c) {
-            double* entry = values + offsets[12 * a + 3 * b + c];
-            entry[0] += blocks[a][b](0, c);
-            entry[1] += blocks[a][b](1, c);
-            entry[2] += blocks[a][b](2, c);
+  detail::visit_material_model(m_material.model, [&](auto model_type) {
+    using Model = decltype(model_type);
+    // A model with a closed-form element stiffness (four tets at a time, and one at a time for a
+    // chunk's last tets) uses it for the exact Hessian; otherwise ∂²ψ/∂F² goes through the generic
+    // block product, projected in the singular-value frame when asked.
+    constexpr bool kClosedForm = requires {
+      typename Model::StiffnessLaneKernel;
+    };
+    const bool closed_form = kClosedForm && !project_psd;
+    for_each_chunk_colored(m_partition, [&](int chunk) {
+      int i = m_partition.chunk_begin[chunk];
+      const int end = m_partition.chunk_begin[chunk + 1];
+      if constexpr (kClosedForm) {
+        if (closed_form) {
+          using detail::kLanes;
+          const typename Model::StiffnessLaneKernel lanes(m_lame);
+          double lane_K[kLanes][12][12];
+          for (; i + kLanes <= end; i += kLanes) {
+            const double* lane_Dm_inv = &m_lane_rest[kLaneRest * (i / kLanes)];
+            // The value array is far larger than the caches: fetch the next group's entries while
+            // this group's blocks are computed.
+            if (i + 2 * kLanes <= end)
+              detail::prefetch_block_entries(&m_block_offsets[48 * (i + kLanes)], values);
+            double F[3][3][kLanes];
+            detail::lane_deformation_gradient(x.data(), &m_sorted_tets[4 * i], lane_Dm_inv, F);
+            lanes(F, lane_Dm_inv, lane_Dm_inv + 9 * kLanes, lane_K);
+            for (int l = 0; l < kLanes; ++l)
+              detail::scatter_element_stiffness(lane_K[l], &m_block_offsets[48 * (i + l)], values);
           }
-    }
+        }
+      }
+      Matrix3d blocks[4][4];
+      for (; i < end; ++i) {
+        const int* tet = &m_sorted_tets[4 * i];
+        const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
+        const Matrix3d F = edge_matrix_at(x.data(), tet) * Dm_inv;
+        const Eigen::Matrix<double, 4, 3> grad_N = shape_function_gradients(Dm_inv);
+        bool done = false;
+        if constexpr (kClosedForm) {
+          if (closed_form) {
+            Model::stiffness_blocks(F, grad_N, m_lame, m_sorted_volume[i], blocks);
+            done = true;
+          }
+        }
+        if (!done) {
+          Matrix9d d2psi;
+          if (project_psd) {
+            SingularFrameHessian frame;
+            frame.svd = rotation_variant_svd(F);
+            Model::singular_frame(frame.svd.sigma, m_lame, frame);
+            d2psi = frame_hessian_matrix(frame, true);
+          } else {
+            d2psi = Model::hessian(F, m_lame);
+          }
+          generic_stiffness_blocks(d2psi, grad_N, m_sorted_volume[i], blocks);
+        }
+        const int* offsets = &m_block_offsets[48 * i];
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b)
+            for (int c = 0; c < 3; ++c) {
+              double* entry = values + offsets[12 * a + 3 * b + c];
+              entry[0] += blocks[a][b](0, c);
+              entry[1] += blocks[a][b](1, c);
+              entry[2] += blocks[a][b](2, c);
+            }
+      }
+    });
   });
   m_element_evaluations += num_tets();
 }

@@ -1,41 +1,19 @@
 #include "strata/core/fem/hyperelastic.hpp"
 
+#include "strata/core/fem/material_registry.hpp"
+
 namespace strata {
 
 double psi(MaterialModel model, const Matrix3d& F, const LameParameters& lame) {
-  switch (model) {
-    case MaterialModel::stvk:
-      return psi_stvk(F, lame);
-    case MaterialModel::corotated:
-      return psi_corotated(F, lame);
-    case MaterialModel::neohookean:
-      return psi_neohookean(F, lame);
-  }
-  return 0.0;
+  return material_traits(model).energy_density(F, lame);
 }
 
 Matrix3d dpsi_dF(MaterialModel model, const Matrix3d& F, const LameParameters& lame) {
-  switch (model) {
-    case MaterialModel::stvk:
-      return dpsi_stvk_dF(F, lame);
-    case MaterialModel::corotated:
-      return dpsi_corotated_dF(F, lame);
-    case MaterialModel::neohookean:
-      return dpsi_neohookean_dF(F, lame);
-  }
-  return Matrix3d::Zero();
+  return material_traits(model).first_piola(F, lame);
 }
 
 Matrix9d d2psi_dF2(MaterialModel model, const Matrix3d& F, const LameParameters& lame) {
-  switch (model) {
-    case MaterialModel::stvk:
-      return d2psi_stvk_dF2(F, lame);
-    case MaterialModel::corotated:
-      return d2psi_corotated_dF2(F, lame);
-    case MaterialModel::neohookean:
-      return d2psi_neohookean_dF2(F, lame);
-  }
-  return Matrix9d::Zero();
+  return material_traits(model).hessian(F, lame);
 }
 
 }  // namespace strata

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "strata/core/fem/material_registry.hpp"
 #include "strata/core/fem/neohookean.hpp"
 
 namespace strata {
@@ -19,8 +20,20 @@ double safe_divide(double numerator, double denominator) {
   return numerator / denominator;
 }
 
+/// Nearest PSD matrix to a symmetric 3 × 3 one; positive definite input (all leading minors > 0)
+/// is returned unchanged.
+Matrix3d project_symmetric_3x3(const Matrix3d& A) {
+  const double minor2 = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+  if (A(0, 0) > 0.0 && minor2 > 0.0 && A.determinant() > 0.0) return A;
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(A);
+  const Vector3d clamped = eigen.eigenvalues().cwiseMax(0.0);
+  return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+}  // namespace
+
 /// StVK: Ψ̂ = μ Σ e_k² + λ/2 (Σ e_k)², e_k = (σ_k² − 1)/2, ψ_i = σ_i (2μ e_i + λ tr E).
-void stvk_frame(const Vector3d& s, const LameParameters& lame, SingularFrameHessian& h) {
+void stvk_singular_frame(const Vector3d& s, const LameParameters& lame, SingularFrameHessian& h) {
   const double mu = lame.mu, lambda = lame.lambda;
   Vector3d e;
   for (int k = 0; k < 3; ++k)
@@ -39,7 +52,8 @@ void stvk_frame(const Vector3d& s, const LameParameters& lame, SingularFrameHess
 }
 
 /// Stable neo-Hookean: ψ_i = c σ_i + λ'(J − α) ∂J/∂σ_i with c = μ'(1 − 1/(I_C + 1)), J = σ₀σ₁σ₂.
-void neohookean_frame(const Vector3d& s, const LameParameters& lame, SingularFrameHessian& h) {
+void neohookean_singular_frame(const Vector3d& s, const LameParameters& lame,
+                               SingularFrameHessian& h) {
   const NeoHookeanConstants k = neohookean_constants(lame);
   const double Ic = s.squaredNorm();
   const double J = s[0] * s[1] * s[2];
@@ -59,7 +73,8 @@ void neohookean_frame(const Vector3d& s, const LameParameters& lame, SingularFra
 }
 
 /// Corotated: ψ_i = 2μ(σ_i − 1) + λ(Σσ − 3); the twist divides as d2psi_corotated_dF2 does.
-void corotated_frame(const Vector3d& s, const LameParameters& lame, SingularFrameHessian& h) {
+void corotated_singular_frame(const Vector3d& s, const LameParameters& lame,
+                              SingularFrameHessian& h) {
   const double trace_term = s.sum() - 3.0;
   Vector3d dpsi;
   for (int i = 0; i < 3; ++i)
@@ -73,33 +88,11 @@ void corotated_frame(const Vector3d& s, const LameParameters& lame, SingularFram
   }
 }
 
-/// Nearest PSD matrix to a symmetric 3 × 3 one; positive definite input (all leading minors > 0)
-/// is returned unchanged.
-Matrix3d project_symmetric_3x3(const Matrix3d& A) {
-  const double minor2 = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  if (A(0, 0) > 0.0 && minor2 > 0.0 && A.determinant() > 0.0) return A;
-  const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(A);
-  const Vector3d clamped = eigen.eigenvalues().cwiseMax(0.0);
-  return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();
-}
-
-}  // namespace
-
 SingularFrameHessian singular_frame_hessian(MaterialModel model, const Matrix3d& F,
                                             const LameParameters& lame) {
   SingularFrameHessian h;
   h.svd = rotation_variant_svd(F);
-  switch (model) {
-    case MaterialModel::stvk:
-      stvk_frame(h.svd.sigma, lame, h);
-      break;
-    case MaterialModel::corotated:
-      corotated_frame(h.svd.sigma, lame, h);
-      break;
-    case MaterialModel::neohookean:
-      neohookean_frame(h.svd.sigma, lame, h);
-      break;
-  }
+  material_traits(model).singular_frame(h.svd.sigma, lame, h);
   return h;
 }
 

@@ -3,31 +3,20 @@
 #include <cmath>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/fem/material_registry.hpp"
 
 namespace strata {
 
 std::string to_string(MaterialModel model) {
-  switch (model) {
-    case MaterialModel::stvk:
-      return "stvk";
-    case MaterialModel::corotated:
-      return "corotated";
-    case MaterialModel::neohookean:
-      return "neohookean";
-  }
-  return "unknown";
+  return material_traits(model).name;
 }
 
 MaterialModel material_model_from_string(const std::string& name) {
-  if (name == "stvk") return MaterialModel::stvk;
-  if (name == "corotated") return MaterialModel::corotated;
-  if (name == "neohookean") return MaterialModel::neohookean;
-  throw InputError("unknown material model \"" + name +
-                   "\" (expected stvk, corotated, neohookean)");
+  return material_traits(name).model;
 }
 
 bool handles_inversion(MaterialModel model) {
-  return model != MaterialModel::stvk;
+  return material_traits(model).handles_inversion;
 }
 
 LameParameters lame_parameters(double youngs_modulus, double poisson_ratio) {

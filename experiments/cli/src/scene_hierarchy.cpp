@@ -4,6 +4,7 @@
 
 #include "strata/app/cut_file.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/hierarchy/refinement_indicator_registry.hpp"
 
 namespace strata::app::detail {
 
@@ -39,9 +40,8 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
   if (value.has("adapt_every")) settings.adapt_every = value.at("adapt_every").integer(1);
   if (value.has("max_passes")) settings.max_passes = value.at("max_passes").integer(1);
   if (value.has("indicator")) {
-    static const char* const kIndicators[] = {"recovery", "force", "stress_jump"};
-    settings.indicator =
-        kIndicators[value.at("indicator").choice({"recovery", "force", "stress_jump"})];
+    const std::vector<std::string> names = refinement_indicator_names();
+    settings.indicator = names[value.at("indicator").choice(names)];
   }
   if (value.has("tolerance")) {
     settings.tolerance = value.at("tolerance").positive();

@@ -122,13 +122,15 @@ std::array<int, 3> SceneValue::int3(int min_value) const {
 }
 
 int SceneValue::choice(std::initializer_list<const char*> names) const {
+  return choice(std::vector<std::string>(names.begin(), names.end()));
+}
+
+int SceneValue::choice(const std::vector<std::string>& names) const {
   const std::string value = string();
   std::string expected;
-  int index = 0;
-  for (const char* name : names) {
-    if (value == name) return index;
-    expected += (index == 0 ? "" : ", ") + std::string(name);
-    ++index;
+  for (std::size_t index = 0; index < names.size(); ++index) {
+    if (value == names[index]) return static_cast<int>(index);
+    expected += (index == 0 ? "" : ", ") + names[index];
   }
   fail("unknown value \"" + value + "\" (expected " + expected + ")");
 }

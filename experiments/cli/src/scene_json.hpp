@@ -42,6 +42,7 @@ class SceneValue {
   std::array<int, 3> int3(int min_value) const;
   /// One of `names`; else `unknown value "x" (expected a, b, c)`; returns its index.
   int choice(std::initializer_list<const char*> names) const;
+  int choice(const std::vector<std::string>& names) const;
 
  private:
   const nlohmann::json& m_value;

@@ -8,6 +8,7 @@
 #include "scene_implicit.hpp"
 #include "scene_json.hpp"
 #include "strata/app/scene_overrides.hpp"
+#include "strata/core/fem/material_registry.hpp"
 
 namespace strata::app {
 namespace {
@@ -182,8 +183,8 @@ Material parse_material(const SceneValue& value) {
   value.expect_object({"model", "youngs_modulus", "poisson_ratio", "density", "damping",
                        "plasticity", "surface_springs"});
   Material material;
-  const int model = value.at("model").choice({"stvk", "corotated", "neohookean"});
-  material.model = static_cast<MaterialModel>(model);
+  const int model = value.at("model").choice(material_model_names());
+  material.model = material_registry()[model].model;
   material.youngs_modulus = value.at("youngs_modulus").positive();
   const SceneValue nu = value.at("poisson_ratio");
   material.poisson_ratio = nu.number();

@@ -5,6 +5,7 @@
 
 #include <strata/core/fem/elastic_model.hpp>
 #include <strata/core/fem/material.hpp>
+#include <strata/core/fem/material_registry.hpp>
 #include <strata/core/mesh/tet_mesh.hpp>
 
 namespace {
@@ -28,8 +29,8 @@ int main() {
   check(std::abs(strata::mesh_volume(mesh) - volume) < 1e-12, "box mesh: volume",
         strata::mesh_volume(mesh));
 
-  for (strata::MaterialModel model : {strata::MaterialModel::stvk, strata::MaterialModel::corotated,
-                                      strata::MaterialModel::neohookean}) {
+  for (const strata::MaterialModelTraits& traits : strata::material_registry()) {
+    const strata::MaterialModel model = traits.model;
     strata::Material material;
     material.model = model;
     material.youngs_modulus = 1e6;

@@ -72,8 +72,8 @@ struct HierarchySettings {
   /// Refinement passes per step (≥ 1): static, solve–mark–refine per load step; dynamic, redos of
   /// a step on a refined cut; and the passes of the initial adaptation.
   int max_passes = 4;
-  /// Refinement criterion: "recovery" (the error estimate, refinement_recovery_estimator.hpp),
-  /// "force" or "stress_jump".
+  /// Refinement criterion, a name in refinement_indicator_registry(): "recovery" (the error
+  /// estimate, refinement_recovery_estimator.hpp), "force" or "stress_jump".
   std::string indicator = "recovery";
   /// τ ∈ (0, 1): the relative displacement error against full resolution the run may have; the
   /// recovery indicator's threshold follows from it (refine where a tet's estimated error exceeds
@@ -253,6 +253,8 @@ class AdaptiveSimulation final : public SimulationRun {
                            const Vector3d& old_momentum);
 
   HierarchySettings m_settings;
+  /// The indicator is an error estimate (refinement_indicator_registry.hpp).
+  bool m_estimates_error = false;
   Material m_material;
   std::vector<DirichletSpec> m_dirichlet;
   std::optional<GroundPlane> m_ground;

@@ -30,6 +30,14 @@ struct SingularFrameHessian {
   Vector3d twist;          ///< (ψ_i + ψ_j)/(σ_i + σ_j) for the same pairs
 };
 
+/// Per model: ∂²Ψ̂/∂σ², flip and twist at the singular values `sigma` (h.svd is left alone).
+void stvk_singular_frame(const Vector3d& sigma, const LameParameters& lame,
+                         SingularFrameHessian& h);
+void corotated_singular_frame(const Vector3d& sigma, const LameParameters& lame,
+                              SingularFrameHessian& h);
+void neohookean_singular_frame(const Vector3d& sigma, const LameParameters& lame,
+                               SingularFrameHessian& h);
+
 /// The frame form of ∂²ψ/∂F² for `model` at F (any F, including inverted and singular ones).
 SingularFrameHessian singular_frame_hessian(MaterialModel model, const Matrix3d& F,
                                             const LameParameters& lame);
