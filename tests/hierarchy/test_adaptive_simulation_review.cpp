@@ -102,8 +102,9 @@ TEST(AdaptiveSimulationReview, StaticRefinementRecordKeepsEnergyWithPrescribedDi
     sim.advance();
   ASSERT_FALSE(sim.changes().empty());
   for (const CutChangeRecord& change : sim.changes()) {
-    if (change.coarsened == 0)
+    if (change.coarsened == 0) {
       EXPECT_NEAR(change.energy_after, change.energy_before, 1e-9 * change.energy_before);
+    }
   }
 }
 

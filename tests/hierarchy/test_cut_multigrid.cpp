@@ -148,7 +148,9 @@ TEST(CutMultigrid, ReachesTheDirectSolution) {
       const std::string label = test.name + " nu " + std::to_string(nu);
       EXPECT_GE(r.levels, 2) << label;
       EXPECT_LE((r.multigrid - r.direct).norm(), 1e-8 * r.direct.norm()) << label;
-      if (test.name.rfind("adaptive", 0) == 0) EXPECT_GT(r.hanging, 0) << label;
+      if (test.name.rfind("adaptive", 0) == 0) {
+        EXPECT_GT(r.hanging, 0) << label;
+      }
       RecordProperty(label, std::to_string(r.iterations) + " iterations, " +
                                 std::to_string(r.levels) + " levels");
     }
