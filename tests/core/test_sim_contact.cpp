@@ -87,8 +87,9 @@ TEST(ContactTermDerivatives, GradientAndHessianOfBarrierAndFriction) {
     const VectorXd column = (gp - gm) / (2 * h);
     // The sphere's curvature term b'∇²φ is left out of the Hessian; only the plane's vertices
     // (below the sphere's reach) are compared exactly.
-    if (x[j - j % 3 + 2] < 0.02)
+    if (x[j - j % 3 + 2] < 0.02) {
       EXPECT_LE((dense.col(j) - column).norm(), 1e-4 * (column.norm() + 1e-3)) << j;
+    }
   }
   // Beyond the tolerance the barrier is infinite.
   VectorXd deep = x0;

@@ -35,8 +35,9 @@ TEST(Steppers, RegistryFindsEveryStepperByItsSettings) {
     EXPECT_EQ(&find_stepper(settings), &traits) << traits.name;
     EXPECT_EQ(traits.is_explicit, traits.mode == SimulationMode::dynamic &&
                                       traits.integrator != Integrator::implicit_euler);
-    if (traits.mode == SimulationMode::dynamic)
+    if (traits.mode == SimulationMode::dynamic) {
       EXPECT_EQ(traits.name, to_string(traits.integrator));
+    }
   }
   EXPECT_EQ(names, (std::set<std::string>{"static", "implicit_euler", "symplectic_euler", "rk4"}));
 }

@@ -58,8 +58,9 @@ TEST(RecoveryEstimator, PeaksAtAKinkOfTheField) {
   estimate.element_error_sq.maxCoeff(&peak);
   EXPECT_NEAR(node_centroid(tree, s.cut.flat.tet_nodes[peak]).x(), 0.4, 1.0 / 6.0 + 1e-12);
   for (Index t = 0; t < estimate.element_error_sq.size(); ++t)
-    if (std::abs(node_centroid(tree, s.cut.flat.tet_nodes[t]).x() - 0.4) > 0.4)
+    if (std::abs(node_centroid(tree, s.cut.flat.tet_nodes[t]).x() - 0.4) > 0.4) {
       EXPECT_LE(estimate.element_error_sq[t], 1e-12 * estimate.element_error_sq[peak]);
+    }
 }
 
 TEST(RecoveryEstimator, FallsAsAUniformCutIsRefined) {
