@@ -215,6 +215,11 @@ void AdaptiveSimulation::initial_adaptation() {
   // Only the pattern of the response matters here, not its last digits.
   statics.newton_tolerance = std::max(statics.newton_tolerance, 1e-6);
   bool changed = false;  // m_constrained and m_mesh_external are ahead of m_simulation
+  // Each pass after the first starts Newton from the previous pass's response carried to the
+  // refined cut through the tree (the previous flat mesh and its deformed positions); with
+  // obstacles every pass starts from rest (a carried state may start inside an obstacle).
+  std::unique_ptr<FlatTreeMesh> previous_flat;
+  VectorXd previous_positions;
   for (int pass = 0; pass < m_settings.max_passes && !all_at_level(*m_cut, max_refine_level());
        ++pass) {
     SimulationOptions options = flatten(0);
@@ -226,11 +231,20 @@ void AdaptiveSimulation::initial_adaptation() {
       solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
                                            std::vector<RegionLoad>{}, m_ground, m_gravity, statics,
                                            std::move(options));
+      if (previous_flat) {
+        const VectorXd x = transfer_vertex_values(*m_tree, *previous_flat, previous_positions,
+                                                  m_constrained->flat);
+        const HangingConstraints& constraints = m_constrained->constraints;
+        solve->set_state(constraints.restrict_to_free(x),
+                         VectorXd::Zero(constraints.restrict_to_free(x).size()));
+      }
       solve->advance();
     } catch (const DivergenceError&) {
       changed = true;
       break;
     }
+    ++m_report.initial_passes;
+    m_report.initial_newton_iterations += solve->counters().newton_iterations;
     m_mesh_external += gravity_forces(solve->vertex_mass(), m_gravity);
     const TetFields fields = solve->model().tet_fields(solve->positions());
     const VectorXd loads = criteria_loads(*solve);
@@ -245,6 +259,10 @@ void AdaptiveSimulation::initial_adaptation() {
     changes.coarsen.clear();
     m_report.refused_refinements += changes.refused;
     if (changes.refine.empty()) break;
+    if (m_obstacles.empty()) {
+      previous_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
+      previous_positions = solve->positions();
+    }
     const CutChangeCounts counts = m_controller->apply(*m_cut, changes, 0);
     m_report.initial_refinements += static_cast<int>(counts.refined + counts.balance_refined);
     changed = true;

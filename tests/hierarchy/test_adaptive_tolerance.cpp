@@ -98,6 +98,9 @@ TEST(AdaptiveTolerance, DefaultsStayWithinTheToleranceOfFullResolution) {
   const double error = run_error(adaptive, full);
   EXPECT_LE(error, h.tolerance);
   EXPECT_GT(initial_tets, plate.coarse.tets.rows());  // adapted before the first step
+  EXPECT_GE(report.initial_passes, 1);
+  EXPECT_LE(report.initial_passes, h.max_passes);
+  EXPECT_GE(report.initial_newton_iterations, report.initial_passes);
   EXPECT_EQ(report.steps_over_tolerance, 0);
   EXPECT_LE(report.max_estimated_error, h.tolerance);
   // The uniform coarse cut is far off: the scene needs the refinement.

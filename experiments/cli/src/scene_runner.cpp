@@ -211,6 +211,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
   block["redone_steps"] = report.redone_steps;
   block["redo_seconds"] = report.redo_seconds;
   block["initial_refinements"] = report.initial_refinements;
+  block["initial_passes"] = report.initial_passes;
+  block["initial_newton_iterations"] = report.initial_newton_iterations;
   block["initial_adaptation_seconds"] = report.initial_adaptation_seconds;
   if (settings.mode == HierarchyMode::precomputed) {
     const PrecomputedCut& cut = *settings.precomputed;

@@ -141,9 +141,11 @@ struct ToleranceReport {
   /// Refinements the criteria asked for but could not make (max_level, element budget, explicit
   /// step veto, hysteresis) over the run.
   long refused_refinements = 0;
-  long redone_steps = 0;        ///< redo passes: dynamic steps redone on a refined cut
-  double redo_seconds = 0.0;    ///< wall time of the discarded attempts [s]
-  int initial_refinements = 0;  ///< nodes refined by the initial adaptation
+  long redone_steps = 0;               ///< redo passes: dynamic steps redone on a refined cut
+  double redo_seconds = 0.0;           ///< wall time of the discarded attempts [s]
+  int initial_refinements = 0;         ///< nodes refined by the initial adaptation
+  int initial_passes = 0;              ///< static solves of the initial adaptation
+  long initial_newton_iterations = 0;  ///< Newton iterations of those solves
   double initial_adaptation_seconds = 0.0;
 };
 
