@@ -53,7 +53,7 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
                         .ramp_time = 1.0,
                         .diagonal = (hi - lo).norm()};
   ImplicitEuler stepper(problem, LinearSolverKind::cholmod,
-                        {settings.max_newton_iterations, settings.newton_tolerance});
+                        {newton_iteration_limit(settings, false), settings.newton_tolerance});
 
   const VectorXd rest = model.rest_positions();
   VectorXd x = rest;

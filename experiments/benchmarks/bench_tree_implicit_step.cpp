@@ -84,7 +84,7 @@ void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind so
                         .nested_spaces = &box.spaces};
   const SolverSettings settings;
   ImplicitEuler stepper(problem, solver,
-                        {settings.max_newton_iterations, settings.newton_tolerance});
+                        {newton_iteration_limit(settings, false), settings.newton_tolerance});
 
   const VectorXd rest = model.rest_positions();
   VectorXd x = rest;
