@@ -10,6 +10,7 @@
 
 #include <strata/core/fem/elastic_model.hpp>
 #include <strata/core/fem/material.hpp>
+#include <strata/core/fem/material_registry.hpp>
 #include <strata/core/mesh/tet_mesh.hpp>
 
 namespace strata::bench {
@@ -27,8 +28,12 @@ inline const std::vector<MeshSize>& mesh_sizes() {
 }
 
 inline const std::vector<MaterialModel>& material_models() {
-  static const std::vector<MaterialModel> models = {MaterialModel::stvk, MaterialModel::corotated,
-                                                    MaterialModel::neohookean};
+  static const std::vector<MaterialModel> models = [] {
+    std::vector<MaterialModel> all;
+    for (const MaterialModelTraits& traits : material_registry())
+      all.push_back(traits.model);
+    return all;
+  }();
   return models;
 }
 

@@ -226,22 +226,34 @@ void AdaptiveSimulation::initial_adaptation() {
     m_mesh_external = peak_loads(options);
     options.extra_mesh_forces = m_mesh_external;
     options.extra_timed_mesh_forces.clear();
-    std::unique_ptr<Simulation> solve;
-    try {
-      solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
-                                           std::vector<RegionLoad>{}, m_ground, m_gravity, statics,
-                                           std::move(options));
-      if (previous_flat) {
-        const VectorXd x = transfer_vertex_values(*m_tree, *previous_flat, previous_positions,
-                                                  m_constrained->flat);
+    const auto static_solve = [&](bool warm) {
+      auto solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
+                                                std::vector<RegionLoad>{}, m_ground, m_gravity,
+                                                statics, options);
+      if (warm) {
         const HangingConstraints& constraints = m_constrained->constraints;
-        solve->set_state(constraints.restrict_to_free(x),
-                         VectorXd::Zero(constraints.restrict_to_free(x).size()));
+        const VectorXd q = constraints.restrict_to_free(transfer_vertex_values(
+            *m_tree, *previous_flat, previous_positions, m_constrained->flat));
+        solve->set_state(q, VectorXd::Zero(q.size()));
       }
       solve->advance();
+      return solve;
+    };
+    std::unique_ptr<Simulation> solve;
+    try {
+      solve = static_solve(previous_flat != nullptr);
     } catch (const DivergenceError&) {
-      changed = true;
-      break;
+      // Newton could not bring the carried start to equilibrium: the same solve from rest.
+      if (previous_flat) {
+        try {
+          solve = static_solve(false);
+        } catch (const DivergenceError&) {
+        }
+      }
+      if (!solve) {
+        changed = true;
+        break;
+      }
     }
     ++m_report.initial_passes;
     m_report.initial_newton_iterations += solve->counters().newton_iterations;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <random>
+#include <tuple>
 
 #include "fem_test_utils.hpp"
 #include "strata/core/fem/elastic_model.hpp"

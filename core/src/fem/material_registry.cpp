@@ -11,12 +11,9 @@ namespace {
 
 template <typename Model>
 MaterialModelTraits traits_of() {
-  return {Model::model, Model::name, Model::summary, Model::handles_inversion,
-          requires {typename Model::LaneKernel;
+  return {Model::model,           Model::name,         Model::summary,  Model::handles_inversion,
+          &Model::energy_density, &Model::first_piola, &Model::hessian, &Model::singular_frame};
 }
-, &Model::energy_density, &Model::first_piola, &Model::hessian, &Model::singular_frame
-};  // namespace
-}  // namespace strata
 
 template <typename... Models>
 std::vector<MaterialModelTraits> build_registry(detail::ModelList<Models...>) {

@@ -1,8 +1,8 @@
 #pragma once
 /// \file hyperelastic.hpp
 /// Model dispatch for the energy density ψ(F), P = ∂ψ/∂F and ∂²ψ/∂F², through the model's
-/// registry entry (material_registry.hpp): one indirect call per evaluation. Mesh-level loops
-/// dispatch once per loop instead (elastic_model.cpp).
+/// registry entry (material_registry.hpp): a registry lookup and an indirect call per evaluation.
+/// Mesh-level loops dispatch once per loop instead (elastic_model.cpp).
 #include "strata/core/fem/corotated.hpp"
 #include "strata/core/fem/neohookean.hpp"
 #include "strata/core/fem/stvk.hpp"

@@ -6,7 +6,8 @@
 ///
 /// Adding a model: its energy density, first Piola stress, ∂²ψ/∂F² and singular-frame Hessian in
 /// its own header and source (as stvk.hpp, corotated.hpp, neohookean.hpp), one enumerator of
-/// MaterialModel and one model type in core/src/fem/material_models.hpp.
+/// MaterialModel, and one model type in core/src/fem/material_models.hpp listed in its
+/// MaterialModels (in the enumerators' order, checked when the registry is built).
 #include <string>
 #include <vector>
 
@@ -23,8 +24,6 @@ struct MaterialModelTraits {
   std::string summary;  ///< one line: the energy density and where the model fails
   /// Whether ψ stays meaningful for inverted elements (J ≤ 0); if not, runs check det F.
   bool handles_inversion;
-  /// Whether the mesh-level loops run this model four tets at a time (vectorised kernels).
-  bool vectorised;
   double (*energy_density)(const Matrix3d& F, const LameParameters& lame);  ///< ψ(F)
   Matrix3d (*first_piola)(const Matrix3d& F, const LameParameters& lame);   ///< ∂ψ/∂F
   Matrix9d (*hessian)(const Matrix3d& F, const LameParameters& lame);       ///< ∂²ψ/∂F²
