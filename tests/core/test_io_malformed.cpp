@@ -178,7 +178,7 @@ TEST(IoMalformed, TruncatedAndCorruptedFilesNeverCrash) {
             : read_text((dir / test_case.source).replace_extension(test_case.sibling_extension));
     int failures = 0, successes = 0;
     auto try_read = [&](const std::string& variant) {
-      const std::string stem = "v" + std::to_string(counter++);
+      const std::string stem = std::string("v").append(std::to_string(counter++));
       const fs::path target = dir / (stem + test_case.extension);
       write_text(target, variant);
       if (!test_case.sibling_extension.empty())

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include "io_test_utils.hpp"
@@ -82,9 +83,10 @@ TEST_P(IoMeshioEncoding, MeshioSeesFrameFieldsWithTheirShapes) {
                  "\"); d=m.point_data[\"displacement\"]; s=m.cell_data[\"stress\"][0]; "
                  "v=m.cell_data[\"von_mises\"][0]; l=m.cell_data[\"level\"][0]; "
                  "print(d.shape, d.sum(), s.shape, v.sum(), l.dtype.kind, l.sum())");
-  EXPECT_EQ(output, "(" + std::to_string(nv) + ", 3) " + std::to_string(nv * 3 / 4) + ".0 (" +
-                        std::to_string(nt) + ", 6) " + std::to_string(2 * nt) + ".0 i " +
-                        std::to_string(3 * nt) + "\n");
+  std::ostringstream expected;
+  expected << "(" << nv << ", 3) " << nv * 3 / 4 << ".0 (" << nt << ", 6) " << 2 * nt << ".0 i "
+           << 3 * nt << "\n";
+  EXPECT_EQ(output, expected.str());
 }
 
 INSTANTIATE_TEST_SUITE_P(Encodings, IoMeshioEncoding,
