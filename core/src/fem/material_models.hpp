@@ -26,24 +26,11 @@ struct StvkModel {
   static constexpr bool handles_inversion = false;
   using LaneKernel = StvkLanes;
   using StiffnessLaneKernel = StvkStiffnessLanes;
-  static void stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double, 4, 3>& grad_N,
-                               const LameParameters& lame, double volume,
-                               Matrix3d (&blocks)[4][4]) {
-    stvk_stiffness_blocks(F, grad_N, lame, volume, blocks);
-  }
-  static double energy_density(const Matrix3d& F, const LameParameters& lame) {
-    return psi_stvk(F, lame);
-  }
-  static Matrix3d first_piola(const Matrix3d& F, const LameParameters& lame) {
-    return dpsi_stvk_dF(F, lame);
-  }
-  static Matrix9d hessian(const Matrix3d& F, const LameParameters& lame) {
-    return d2psi_stvk_dF2(F, lame);
-  }
-  static void singular_frame(const Vector3d& sigma, const LameParameters& lame,
-                             SingularFrameHessian& h) {
-    stvk_singular_frame(sigma, lame, h);
-  }
+  static constexpr auto* stiffness_blocks = &stvk_stiffness_blocks;
+  static constexpr auto* energy_density = &psi_stvk;
+  static constexpr auto* first_piola = &dpsi_stvk_dF;
+  static constexpr auto* hessian = &d2psi_stvk_dF2;
+  static constexpr auto* singular_frame = &stvk_singular_frame;
 };
 
 struct CorotatedModel {
@@ -53,19 +40,10 @@ struct CorotatedModel {
       "corotated linear, psi = mu |F - R|^2 + lambda/2 tr(R^T F - I)^2 with F = RS; handles "
       "inversion";
   static constexpr bool handles_inversion = true;
-  static double energy_density(const Matrix3d& F, const LameParameters& lame) {
-    return psi_corotated(F, lame);
-  }
-  static Matrix3d first_piola(const Matrix3d& F, const LameParameters& lame) {
-    return dpsi_corotated_dF(F, lame);
-  }
-  static Matrix9d hessian(const Matrix3d& F, const LameParameters& lame) {
-    return d2psi_corotated_dF2(F, lame);
-  }
-  static void singular_frame(const Vector3d& sigma, const LameParameters& lame,
-                             SingularFrameHessian& h) {
-    corotated_singular_frame(sigma, lame, h);
-  }
+  static constexpr auto* energy_density = &psi_corotated;
+  static constexpr auto* first_piola = &dpsi_corotated_dF;
+  static constexpr auto* hessian = &d2psi_corotated_dF2;
+  static constexpr auto* singular_frame = &corotated_singular_frame;
 };
 
 struct NeoHookeanModel {
@@ -76,25 +54,14 @@ struct NeoHookeanModel {
       "handles inversion";
   static constexpr bool handles_inversion = true;
   using LaneKernel = NeoHookeanLanes;
-  static double energy_density(const Matrix3d& F, const LameParameters& lame) {
-    return psi_neohookean(F, lame);
-  }
-  static Matrix3d first_piola(const Matrix3d& F, const LameParameters& lame) {
-    return dpsi_neohookean_dF(F, lame);
-  }
-  static Matrix9d hessian(const Matrix3d& F, const LameParameters& lame) {
-    return d2psi_neohookean_dF2(F, lame);
-  }
-  static void singular_frame(const Vector3d& sigma, const LameParameters& lame,
-                             SingularFrameHessian& h) {
-    neohookean_singular_frame(sigma, lame, h);
-  }
+  static constexpr auto* energy_density = &psi_neohookean;
+  static constexpr auto* first_piola = &dpsi_neohookean_dF;
+  static constexpr auto* hessian = &d2psi_neohookean_dF2;
+  static constexpr auto* singular_frame = &neohookean_singular_frame;
 };
 
 template <typename... Models>
-struct ModelList {
-  static constexpr int size = sizeof...(Models);
-};
+struct ModelList {};
 
 /// Every model, in MaterialModel's order.
 using MaterialModels = ModelList<StvkModel, CorotatedModel, NeoHookeanModel>;

@@ -11,8 +11,8 @@ namespace {
 
 template <typename Model>
 MaterialModelTraits traits_of() {
-  return {Model::model,           Model::name,         Model::summary,  Model::handles_inversion,
-          &Model::energy_density, &Model::first_piola, &Model::hessian, &Model::singular_frame};
+  return {Model::model,          Model::name,        Model::summary, Model::handles_inversion,
+          Model::energy_density, Model::first_piola, Model::hessian, Model::singular_frame};
 }
 
 template <typename... Models>
