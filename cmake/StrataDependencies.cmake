@@ -16,3 +16,18 @@ if(NOT TARGET strata_cholmod)
   target_include_directories(strata_cholmod SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
   target_link_libraries(strata_cholmod INTERFACE ${CHOLMOD_LIBRARY})
 endif()
+
+# hypre (BoomerAMG, libhypre-dev) ships no CMake file either; Debian builds it on Open MPI, whose
+# C interface it needs (called from C++, without the deprecated C++ bindings).
+set(MPI_CXX_SKIP_MPICXX TRUE)
+find_package(MPI REQUIRED COMPONENTS CXX)
+find_path(HYPRE_INCLUDE_DIR HYPRE.h PATH_SUFFIXES hypre)
+find_library(HYPRE_LIBRARY HYPRE)
+if(NOT HYPRE_INCLUDE_DIR OR NOT HYPRE_LIBRARY)
+  message(FATAL_ERROR "hypre not found: install libhypre-dev")
+endif()
+if(NOT TARGET strata_hypre)
+  add_library(strata_hypre INTERFACE)
+  target_include_directories(strata_hypre SYSTEM INTERFACE ${HYPRE_INCLUDE_DIR})
+  target_link_libraries(strata_hypre INTERFACE ${HYPRE_LIBRARY} MPI::MPI_CXX)
+endif()

@@ -1,9 +1,10 @@
-// One backward-Euler step (ImplicitEuler, Newton + CHOLMOD) of a box clamped at x = 0 under
-// gravity, starting from rest each time: wall time per step and tets/s. The symbolic analysis of
-// the linear solver happens in an untimed warm-up step; the timed steps reuse it like a running
-// simulation. Threads follow strata's process policy (TBB at <n>, CHOLMOD's BLAS and OpenMP at
-// 1). Names:
-// implicit_euler_step/<model>/tets:<#T>/threads:<n>.
+// One backward-Euler step (ImplicitEuler, Newton + CHOLMOD, or CG with hypre's algebraic
+// multigrid) of a box clamped at x = 0 under gravity, starting from rest each time: wall time per
+// step and tets/s. The symbolic analysis of the linear solver (or the first AMG hierarchy) happens
+// in an untimed warm-up step; the timed steps reuse it like a running simulation. Threads follow
+// strata's process policy (TBB at <n>, CHOLMOD's BLAS and OpenMP at 1; hypre runs on one).
+// Names: implicit_euler_step/<model>/tets:<#T>/threads:<n> (CHOLMOD) and
+// implicit_euler_step/<model>/solver:amg/tets:<#T>/threads:<n> (StVK only).
 #include <benchmark/benchmark.h>
 
 #include <strata/core/common/parallel.hpp>
@@ -21,7 +22,7 @@ namespace strata::bench {
 namespace {
 
 void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialModel material,
-                             int threads) {
+                             int threads, LinearSolverKind solver) {
   set_thread_policy({.threads = threads});
   const ModelCase& c = model_case(size, material);
   const ElasticModel& model = *c.model;
@@ -52,7 +53,7 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
                         .stiffness_damping = mat.stiffness_damping,
                         .ramp_time = 1.0,
                         .diagonal = (hi - lo).norm()};
-  ImplicitEuler stepper(problem, LinearSolverKind::cholmod,
+  ImplicitEuler stepper(problem, solver,
                         {newton_iteration_limit(settings, false), settings.newton_tolerance});
 
   const VectorXd rest = model.rest_positions();
@@ -60,6 +61,8 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
   VectorXd v = VectorXd::Zero(model.num_dofs());
   stepper.step(0.0, settings.dt, x, v);  // warm-up: symbolic analysis
 
+  const long cg_start = stepper.linear_solver().cg_iterations();
+  const long setups_start = stepper.linear_solver().multigrid_setups();
   long newton_iterations = 0;
   bool converged = true;
   for (auto _ : state) {
@@ -76,19 +79,27 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
   state.counters["dofs"] = double(model.num_dofs());
   state.counters["newton_iterations"] = double(newton_iterations) / double(state.iterations());
   state.counters["dt"] = settings.dt;
+  const double n = double(state.iterations());
+  state.counters["cg_iterations"] = double(stepper.linear_solver().cg_iterations() - cg_start) / n;
+  state.counters["amg_setups"] =
+      double(stepper.linear_solver().multigrid_setups() - setups_start) / n;
   if (!converged) state.SkipWithError("Newton did not converge");
 }
 
 const bool registered = [] {
   for (const MeshSize& size : mesh_sizes())
     for (MaterialModel material : material_models())
-      for (int threads : thread_counts()) {
-        benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
-            benchmark_name("implicit_euler_step/" + to_string(material), size, threads).c_str(),
-            implicit_step_benchmark, size, material, threads);
-        b->Unit(benchmark::kMillisecond)->UseRealTime();
-        if (size.num_tets() > 100000) b->Iterations(1);
-      }
+      for (int threads : thread_counts())
+        for (LinearSolverKind solver : {LinearSolverKind::cholmod, LinearSolverKind::amg}) {
+          if (solver == LinearSolverKind::amg && material != MaterialModel::stvk) continue;
+          const std::string prefix = "implicit_euler_step/" + to_string(material) +
+                                     (solver == LinearSolverKind::amg ? "/solver:amg" : "");
+          benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+              benchmark_name(prefix, size, threads).c_str(), implicit_step_benchmark, size,
+              material, threads, solver);
+          b->Unit(benchmark::kMillisecond)->UseRealTime();
+          if (size.num_tets() > 100000) b->Iterations(1);
+        }
   return true;
 }();
 

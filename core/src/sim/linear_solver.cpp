@@ -3,9 +3,72 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
+#include "strata/core/sim/algebraic_multigrid.hpp"
+
 namespace strata {
+
+/// The preconditioner of the multigrid path: one cycle over the tree's levels or BoomerAMG's.
+struct SpdSolver::Cycle {
+  virtual ~Cycle() = default;
+  /// Builds the levels for A; false when the coarsest operator does not factorise.
+  virtual bool setup(const SparseMatrixd& A) = 0;
+  /// Uses A (same pattern) on the finest level from now on, where the cycle can.
+  virtual void update_finest(const SparseMatrixd& A) = 0;
+  virtual void apply(ConstRef<VectorXd> r, VectorXd& z) const = 0;
+  virtual double setup_seconds() const = 0;
+  virtual int num_levels() const = 0;
+};
+
+namespace {
+
+struct TreeCycle final : SpdSolver::Cycle {
+  MultigridPreconditioner preconditioner;
+  explicit TreeCycle(std::vector<SparseMatrixd> prolongations)
+      : preconditioner(std::move(prolongations)) {}
+  bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
+  void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
+  void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
+  double setup_seconds() const override { return preconditioner.setup_seconds(); }
+  int num_levels() const override { return preconditioner.num_levels(); }
+};
+
+/// BoomerAMG's coarse spaces with strata's cycle: the interpolations come from hypre (once per
+/// system size; later setups keep them), the Galerkin products, Chebyshev smoothers and coarsest
+/// factorisation are those of the tree's multigrid, on TBB threads.
+struct AlgebraicCycle final : SpdSolver::Cycle {
+  AlgebraicMultigridOptions options;
+  std::unique_ptr<MultigridPreconditioner> cycle;
+  Index rows = -1;
+  double seconds = 0.0;
+
+  explicit AlgebraicCycle(std::vector<int> row_components) {
+    options.row_components = std::move(row_components);
+  }
+  bool setup(const SparseMatrixd& A) override {
+    const auto start = std::chrono::steady_clock::now();
+    if (cycle == nullptr || rows != A.rows()) {
+      cycle.reset();
+      AlgebraicMultigrid amg(options);
+      if (!amg.setup(A)) return false;
+      std::vector<SparseMatrixd> prolongations = amg.prolongations();
+      if (prolongations.empty()) return false;  // too small to coarsen
+      cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations));
+      rows = A.rows();
+    }
+    const bool ok = cycle->setup(A);
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return ok;
+  }
+  void update_finest(const SparseMatrixd& A) override { cycle->update_finest(A); }
+  void apply(ConstRef<VectorXd> r, VectorXd& z) const override { cycle->apply(r, z); }
+  double setup_seconds() const override { return seconds; }
+  int num_levels() const override { return cycle != nullptr ? cycle->num_levels() : 0; }
+};
+
+}  // namespace
 
 struct SpdSolver::Impl {
   Eigen::CholmodSupernodalLLT<SparseMatrixd, Eigen::Lower> cholmod;
@@ -18,6 +81,8 @@ SpdSolver::SpdSolver(LinearSolverKind kind)
     : m_impl(std::make_unique<Impl>()),
       m_requested(kind),
       m_kind(kind == LinearSolverKind::cg ? kind : LinearSolverKind::cholmod) {
+  m_choose_by_size = kind == LinearSolverKind::automatic;
+  if (kind == LinearSolverKind::amg) use_algebraic_multigrid();
   m_impl->cg.setTolerance(1e-12);
   // A failed factorisation is an expected outcome (Newton then projects the Hessian): no
   // CHOLMOD warning on stderr.
@@ -37,13 +102,27 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
       has_levels && (requested == LinearSolverKind::multigrid ||
                      (requested == LinearSolverKind::automatic &&
                       static_cast<Index>(free_dofs.size()) >= kMultigridMinDofs));
+  m_choose_by_size = false;
+  m_free_components.resize(free_dofs.size());
+  for (std::size_t i = 0; i < free_dofs.size(); ++i)
+    m_free_components[i] = static_cast<int>(free_dofs[i] % 3);
   if (multigrid) {
     m_kind = LinearSolverKind::multigrid;
-    m_multigrid =
-        std::make_unique<MultigridPreconditioner>(free_dof_prolongations(*spaces, free_dofs));
+    m_multigrid = std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs));
+  } else if (requested == LinearSolverKind::amg) {
+    use_algebraic_multigrid();
+  } else if (requested == LinearSolverKind::automatic) {
+    m_kind = LinearSolverKind::cholmod;
+    m_choose_by_size = true;
   } else {
     m_kind = requested == LinearSolverKind::cg ? LinearSolverKind::cg : LinearSolverKind::cholmod;
   }
+}
+
+void SpdSolver::use_algebraic_multigrid() {
+  m_kind = LinearSolverKind::amg;
+  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_components);
+  m_multigrid_stale = true;
 }
 
 int SpdSolver::multigrid_levels() const {
@@ -55,7 +134,9 @@ bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x)
     x.resize(0);
     return true;
   }
-  if (m_kind == LinearSolverKind::multigrid) return solve_multigrid(A, b, x);
+  if (m_choose_by_size) choose_by_size(A);
+  if (m_kind == LinearSolverKind::multigrid || m_kind == LinearSolverKind::amg)
+    return solve_multigrid(A, b, x);
   if (m_kind == LinearSolverKind::cholmod) return solve_cholmod(A, b, x);
   m_impl->cg.setMaxIterations(std::max<Index>(1000, 10 * A.rows()));
   m_impl->cg.compute(A);
@@ -66,20 +147,30 @@ bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x)
   return m_impl->cg.info() == Eigen::Success && x.allFinite();
 }
 
+void SpdSolver::analyze(const SparseMatrixd& A) {
+  m_impl->cholmod.analyzePattern(A);
+  m_rows = A.rows();
+  m_nonzeros = A.nonZeros();
+  ++m_analyses;
+  m_has_factor = false;
+  // One factorisation costs `fl` flops, one PCG iteration about 4·nnz(L) + 4·nnz(A).
+  const double factor_flops = m_impl->cholmod.cholmod().fl;
+  const double iteration_flops =
+      4.0 * m_impl->cholmod.cholmod().lnz + 4.0 * static_cast<double>(A.nonZeros());
+  const double worth = iteration_flops > 0.0 ? 0.5 * factor_flops / iteration_flops : 0.0;
+  m_reuse_budget = static_cast<int>(std::clamp(worth, 12.0, 60.0));
+  m_factor_flops_per_nonzero = factor_flops / std::max(1.0, static_cast<double>(A.nonZeros()));
+}
+
+void SpdSolver::choose_by_size(const SparseMatrixd& A) {
+  m_choose_by_size = false;
+  if (A.rows() < kAlgebraicMultigridMinDofs) return;
+  analyze(A);  // kept: CHOLMOD is also the fallback of algebraic multigrid
+  if (m_factor_flops_per_nonzero >= kAlgebraicMultigridMinFill) use_algebraic_multigrid();
+}
+
 bool SpdSolver::solve_cholmod(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
-  if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) {
-    m_impl->cholmod.analyzePattern(A);
-    m_rows = A.rows();
-    m_nonzeros = A.nonZeros();
-    ++m_analyses;
-    m_has_factor = false;
-    // One factorisation costs `fl` flops, one PCG iteration about 4·nnz(L) + 4·nnz(A).
-    const double factor_flops = m_impl->cholmod.cholmod().fl;
-    const double iteration_flops =
-        4.0 * m_impl->cholmod.cholmod().lnz + 4.0 * static_cast<double>(A.nonZeros());
-    const double worth = iteration_flops > 0.0 ? 0.5 * factor_flops / iteration_flops : 0.0;
-    m_reuse_budget = static_cast<int>(std::clamp(worth, 12.0, 60.0));
-  }
+  if (A.rows() != m_rows || A.nonZeros() != m_nonzeros) analyze(A);
   if (m_has_factor && solve_with_previous_factor(A, b, x)) {
     ++m_reused_solves;
     return true;

@@ -30,6 +30,8 @@ std::string to_string(LinearSolverKind kind) {
       return "cg";
     case LinearSolverKind::multigrid:
       return "multigrid";
+    case LinearSolverKind::amg:
+      return "amg";
     case LinearSolverKind::automatic:
       return "auto";
   }
@@ -54,8 +56,10 @@ LinearSolverKind linear_solver_from_string(const std::string& name) {
   if (name == "cholmod") return LinearSolverKind::cholmod;
   if (name == "cg") return LinearSolverKind::cg;
   if (name == "multigrid") return LinearSolverKind::multigrid;
+  if (name == "amg") return LinearSolverKind::amg;
   if (name == "auto") return LinearSolverKind::automatic;
-  throw InputError("unknown linear solver '" + name + "' (valid: cholmod, cg, multigrid, auto)");
+  throw InputError("unknown linear solver '" + name +
+                   "' (valid: cholmod, cg, multigrid, amg, auto)");
 }
 
 int newton_iteration_limit(const SolverSettings& settings, bool contact) {

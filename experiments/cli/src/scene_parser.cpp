@@ -245,8 +245,9 @@ SolverSettings parse_solver(const SceneValue& value) {
   }
   if (value.has("load_steps")) solver.load_steps = value.at("load_steps").integer(1);
   if (value.has("linear_solver")) {
-    solver.linear_solver = static_cast<LinearSolverKind>(
-        value.at("linear_solver").choice({"cholmod", "cg", "multigrid", "auto"}));
+    static const std::vector<std::string> kinds = {"cholmod", "cg", "multigrid", "amg", "auto"};
+    solver.linear_solver =
+        linear_solver_from_string(kinds[value.at("linear_solver").choice(kinds)]);
   }
   if (value.has("newton_tolerance")) {
     solver.newton_tolerance = value.at("newton_tolerance").positive();

@@ -20,6 +20,11 @@
 /// convergence within 500 iterations on a fresh hierarchy, or a coarsest operator that does not
 /// factorise), CHOLMOD solves it (counted, direct_fallbacks): if A factorises, CHOLMOD takes every
 /// later solve (kind() becomes cholmod); if not, A is indefinite and the solve fails.
+///
+/// Algebraic multigrid takes the same path with coarse spaces from hypre's BoomerAMG
+/// (algebraic_multigrid.hpp) in place of the tree's levels: its interpolations are computed at the
+/// first setup for a system size and kept; every setup recomputes the Galerkin products, and the
+/// cycle, PCG, staleness rule and CHOLMOD fallback are the tree's.
 #include <memory>
 #include <vector>
 
@@ -31,6 +36,12 @@ namespace strata {
 
 /// Free DOFs from which `automatic` picks multigrid over CHOLMOD (when coarser levels exist).
 inline constexpr Index kMultigridMinDofs = 8000;
+/// Without coarser levels, `automatic` picks algebraic multigrid over CHOLMOD for systems of at
+/// least kAlgebraicMultigridMinDofs free DOFs whose Cholesky factorisation (CHOLMOD's symbolic
+/// analysis) costs at least kAlgebraicMultigridMinFill flops per non-zero of A: compact 3D bodies
+/// from about 40k vertices, not slender ones, whose separators stay small.
+inline constexpr Index kAlgebraicMultigridMinDofs = 20000;
+inline constexpr double kAlgebraicMultigridMinFill = 20000.0;
 
 class SpdSolver {
  public:
@@ -46,8 +57,10 @@ class SpdSolver {
 
   /// Resolves `automatic` and `multigrid` for a system with these free DOFs (ascending indices
   /// into 3 · spaces->num_fine_vertices()) and, when multigrid is chosen, builds its transfers.
-  /// `spaces` may be null or empty (no coarser levels: CHOLMOD). Without this call `automatic`
-  /// and `multigrid` solve with CHOLMOD.
+  /// `spaces` may be null or empty (no coarser levels): then `multigrid` is CHOLMOD and
+  /// `automatic` chooses between CHOLMOD and algebraic multigrid at the first solve, by the
+  /// system's size and its factorisation's cost (kAlgebraicMultigridMinFill). Without this call
+  /// the same holds.
   void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs);
 
   /// Relative residual ‖b − A x‖ / ‖b‖ at which the iterative paths (CG on a previous factor,
@@ -62,7 +75,8 @@ class SpdSolver {
   /// Whether a failed solve proves the matrix indefinite (CHOLMOD), or at least negative
   /// curvature is detected (multigrid-PCG): Newton may then try the exact Hessian.
   bool detects_indefinite() const { return m_kind != LinearSolverKind::cg; }
-  /// Multigrid setups (Galerkin products and coarsest factorisation) so far.
+  /// Multigrid setups (Galerkin products and coarsest factorisation, or algebraic hierarchies)
+  /// so far.
   long multigrid_setups() const { return m_multigrid_setups; }
   /// Multigrid solves that did not converge on a fresh hierarchy and were solved by CHOLMOD.
   long direct_fallbacks() const { return m_direct_fallbacks; }
@@ -70,11 +84,17 @@ class SpdSolver {
   double multigrid_setup_seconds() const { return m_multigrid_setup_seconds; }
   /// Levels of the multigrid hierarchy (0 unless multigrid).
   int multigrid_levels() const;
+  /// Flops of a Cholesky factorisation per non-zero of A, from the last symbolic analysis (0
+  /// before any): the cost `automatic` compares with kAlgebraicMultigridMinFill.
+  double factor_flops_per_nonzero() const { return m_factor_flops_per_nonzero; }
   long analyses() const { return m_analyses; }              ///< symbolic analyses so far
   long factorizations() const { return m_factorizations; }  ///< numeric factorisations so far
   long cg_iterations() const { return m_cg_iterations; }    ///< CG iterations so far
   /// Solves answered by CG on the previous factor (no factorisation).
   long reused_factor_solves() const { return m_reused_solves; }
+
+  /// The multigrid path's preconditioner, the tree's cycle or BoomerAMG's (defined in the source).
+  struct Cycle;
 
  private:
   struct Impl;
@@ -88,7 +108,8 @@ class SpdSolver {
   long m_cg_iterations = 0;
   long m_reused_solves = 0;
   bool m_has_factor = false;
-  int m_reuse_budget = 0;  ///< PCG iterations allowed before refactorising
+  int m_reuse_budget = 0;                   ///< PCG iterations allowed before refactorising
+  double m_factor_flops_per_nonzero = 0.0;  ///< of the last analysis
   double m_relative_tolerance = 1e-10;
   int m_max_iterations = 500;
   Index m_multigrid_rows = -1;
@@ -98,7 +119,12 @@ class SpdSolver {
   double m_multigrid_setup_seconds = 0.0;
   bool m_multigrid_stale = true;
   double m_iterations_per_decade = -1.0;  ///< of the first solve after the last setup
-  std::unique_ptr<MultigridPreconditioner> m_multigrid;
+  bool m_choose_by_size = false;          ///< `automatic` without nested spaces: decided at a solve
+  std::vector<int> m_free_components;  ///< component (0–2) of each free DOF; empty: interleaved
+  std::unique_ptr<Cycle> m_multigrid;
+  void use_algebraic_multigrid();
+  void analyze(const SparseMatrixd& A);         ///< CHOLMOD's symbolic analysis of A's pattern
+  void choose_by_size(const SparseMatrixd& A);  ///< `automatic` without nested spaces
   bool solve_with_previous_factor(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   bool solve_cholmod(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   bool solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);

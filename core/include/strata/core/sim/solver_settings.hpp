@@ -10,9 +10,11 @@ enum class SimulationMode { dynamic, static_equilibrium };
 enum class Integrator { symplectic_euler, rk4, implicit_euler };
 /// cholmod: CHOLMOD supernodal Cholesky; cg: conjugate gradients with incomplete Cholesky;
 /// multigrid: conjugate gradients preconditioned by a V-cycle over the refinement tree's levels
-/// (multigrid.hpp; CHOLMOD where the mesh has no coarser levels); automatic: multigrid on meshes
-/// with coarser levels and at least kMultigridMinDofs free DOFs, CHOLMOD otherwise.
-enum class LinearSolverKind { cholmod, cg, multigrid, automatic };
+/// (multigrid.hpp; CHOLMOD where the mesh has no coarser levels); amg: conjugate gradients
+/// preconditioned by algebraic multigrid (algebraic_multigrid.hpp, hypre's BoomerAMG); automatic:
+/// multigrid on meshes with coarser levels and at least kMultigridMinDofs free DOFs, elsewhere
+/// algebraic multigrid from kAlgebraicMultigridMinDofs free DOFs and CHOLMOD below.
+enum class LinearSolverKind { cholmod, cg, multigrid, automatic, amg };
 
 struct SolverSettings {
   SimulationMode mode = SimulationMode::dynamic;
@@ -48,7 +50,7 @@ struct SolverSettings {
 
 std::string to_string(SimulationMode mode);    ///< "dynamic" | "static"
 std::string to_string(Integrator integrator);  ///< "symplectic_euler" | "rk4" | "implicit_euler"
-std::string to_string(LinearSolverKind kind);  ///< "cholmod" | "cg" | "multigrid" | "auto"
+std::string to_string(LinearSolverKind kind);  ///< "cholmod" | "cg" | "multigrid" | "amg" | "auto"
 /// Parsers for scene names; throw InputError listing the valid names.
 SimulationMode simulation_mode_from_string(const std::string& name);
 Integrator integrator_from_string(const std::string& name);
