@@ -98,10 +98,7 @@ TEST(AlgebraicMultigrid, CycleIsSymmetricPositiveDefinite) {
   for (bool rollers : {false, true}) {
     const BoxSystem system = box_system(Vector3d(1.0, 1.0, 1.0), {6, 6, 6}, 0.3,
                                         rollers ? clamped_and_rollers : clamped_end);
-    AlgebraicMultigridOptions options;
-    for (Index dof : system.free_dofs)
-      options.row_components.push_back(static_cast<int>(dof % 3));
-    AlgebraicMultigrid amg(options);
+    AlgebraicMultigrid amg({.row_dofs = system.free_dofs});
     ASSERT_TRUE(amg.setup(system.A));
     const Index n = system.A.rows();
     const VectorXd r1 = VectorXd::LinSpaced(n, -1.0, 1.0).array().sin();
@@ -125,18 +122,49 @@ TEST(AlgebraicMultigrid, CycleIsSymmetricPositiveDefinite) {
       EXPECT_EQ(prolongations[k].rows(), prolongations[k + 1].cols());
       EXPECT_LT(prolongations[k].cols(), prolongations[k].rows());
     }
+    // Whole vertices (no rollers): nodal coarsening keeps x, y, z triples on every level, and
+    // interpolation never mixes components.
+    if (!rollers) {
+      for (const SparseMatrixd& P : prolongations) {
+        EXPECT_EQ(P.cols() % 3, 0);
+        for (Index j = 0; j < P.outerSize(); ++j)
+          for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
+            if (it.value() != 0.0) {
+              EXPECT_EQ(it.row() % 3, j % 3) << "row " << it.row();
+            }
+      }
+    }
   }
 }
 
 TEST(AlgebraicMultigrid, RejectsMismatchedComponents) {
   const BoxSystem system = box_system(Vector3d(1.0, 1.0, 1.0), {2, 2, 2}, 0.3, clamped_end);
-  AlgebraicMultigridOptions options;
-  options.row_components.assign(static_cast<std::size_t>(system.A.rows()) - 1, 0);
-  AlgebraicMultigrid amg(options);
+  std::vector<Index> too_few(system.free_dofs.begin(), system.free_dofs.end() - 1);
+  AlgebraicMultigrid amg({.row_dofs = too_few});
   EXPECT_THROW(amg.setup(system.A), std::invalid_argument);
   AlgebraicMultigrid unset;
   VectorXd z;
   EXPECT_THROW(unset.apply(VectorXd::Ones(3), z), std::logic_error);
+  AlgebraicMultigrid whole({.row_dofs = system.free_dofs});
+  ASSERT_TRUE(whole.setup(system.A));
+  EXPECT_THROW(whole.apply(VectorXd::Ones(system.A.rows() + 1), z), std::invalid_argument);
+}
+
+TEST(AlgebraicMultigrid, SolvesWithoutTheFreeDofs) {
+  // Without use_nested_spaces the rows are taken as whole vertices (a multiple of 3) or as one
+  // scalar field each; either way a valid preconditioner.
+  for (bool rollers : {false, true}) {
+    const BoxSystem system = box_system(Vector3d(2.0, 1.0, 1.0), {12, 6, 6}, 0.3,
+                                        rollers ? clamped_and_rollers : clamped_end);
+    SpdSolver solver(LinearSolverKind::amg);
+    solver.set_relative_tolerance(1e-12);
+    const VectorXd b = VectorXd::LinSpaced(system.A.rows(), -1.0, 2.0);
+    VectorXd x;
+    ASSERT_TRUE(solver.solve(system.A, b, x)) << rollers;
+    EXPECT_EQ(solver.kind(), LinearSolverKind::amg);
+    const VectorXd expected = direct_solution(system.A, b);
+    EXPECT_LE((x - expected).norm(), 1e-8 * expected.norm()) << rollers;
+  }
 }
 
 TEST(AlgebraicMultigrid, AutomaticChoiceFollowsTheFactorisationCost) {

@@ -53,6 +53,7 @@ void ensure_hypre() {
     // A singleton process needs no supporting daemon (Open MPI would otherwise start one).
     setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
     int provided = 0;
+    // Every MPI and hypre call is serialised by the mutex; hypre needs no more than that.
     if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS)
       throw std::runtime_error("algebraic multigrid: MPI could not be initialised");
     g_finalize_mpi = true;
@@ -67,7 +68,7 @@ struct IjVector {
   HYPRE_ParVector par = nullptr;
 
   explicit IjVector(HYPRE_BigInt n) {
-    HYPRE_IJVectorCreate(MPI_COMM_WORLD, 0, n - 1, &ij);
+    HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, n - 1, &ij);
     HYPRE_IJVectorSetObjectType(ij, HYPRE_PARCSR);
     HYPRE_IJVectorInitialize(ij);
     HYPRE_IJVectorAssemble(ij);
@@ -117,19 +118,16 @@ int AlgebraicMultigrid::num_levels() const {
 bool AlgebraicMultigrid::setup(const SparseMatrixd& A) {
   if (!A.isCompressed())
     throw std::invalid_argument("algebraic multigrid: the matrix must be compressed");
-  const std::vector<int>& components = m_options.row_components;
+  const std::vector<Index>& dofs = m_options.row_dofs;
   if (A.rows() != A.cols() ||
-      (components.empty() ? A.rows() % 3 != 0 : static_cast<Index>(components.size()) != A.rows()))
+      (dofs.empty() ? A.rows() % 3 != 0 : static_cast<Index>(dofs.size()) != A.rows()))
     throw std::invalid_argument(
-        "algebraic multigrid: the matrix must be square with a component "
-        "per row (or a multiple of 3 rows)");
-  // Whole vertices (x, y, z in consecutive rows) throughout: nodal coarsening.
+        "algebraic multigrid: the matrix must be square with a DOF per "
+        "row (or a multiple of 3 rows)");
+  // Whole vertices (3v, 3v + 1, 3v + 2 in consecutive rows) throughout: nodal coarsening.
   bool whole_vertices = A.rows() % 3 == 0;
-  for (std::size_t i = 0; whole_vertices && i < components.size(); ++i)
-    whole_vertices = components[i] == static_cast<int>(i % 3);
-  int num_functions = 3;
-  if (!components.empty() && !whole_vertices)
-    num_functions = 1 + *std::max_element(components.begin(), components.end());
+  for (std::size_t i = 0; whole_vertices && i < dofs.size(); ++i)
+    whole_vertices = dofs[i] == 3 * (dofs[i - i % 3] / 3) + static_cast<Index>(i % 3);
   const auto start = std::chrono::steady_clock::now();
   const std::lock_guard lock(hypre_mutex());
   ensure_hypre();
@@ -144,7 +142,7 @@ bool AlgebraicMultigrid::setup(const SparseMatrixd& A) {
   std::vector<HYPRE_Int> row_sizes(static_cast<std::size_t>(n));
   for (HYPRE_BigInt i = 0; i < n; ++i)
     row_sizes[i] = A.outerIndexPtr()[i + 1] - A.outerIndexPtr()[i];
-  bool ok = HYPRE_IJMatrixCreate(MPI_COMM_WORLD, 0, n - 1, 0, n - 1, &impl.matrix) == 0;
+  bool ok = HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &impl.matrix) == 0;
   ok = ok && HYPRE_IJMatrixSetObjectType(impl.matrix, HYPRE_PARCSR) == 0;
   ok = ok && HYPRE_IJMatrixSetRowSizes(impl.matrix, row_sizes.data()) == 0;
   ok = ok && HYPRE_IJMatrixInitialize(impl.matrix) == 0;
@@ -164,13 +162,14 @@ bool AlgebraicMultigrid::setup(const SparseMatrixd& A) {
   HYPRE_BoomerAMGSetPrintLevel(impl.amg, 0);
   HYPRE_BoomerAMGSetMaxIter(impl.amg, 1);  // one V-cycle per application
   HYPRE_BoomerAMGSetTol(impl.amg, 0.0);
-  HYPRE_BoomerAMGSetNumFunctions(impl.amg, num_functions);
+  HYPRE_BoomerAMGSetNumFunctions(impl.amg, 3);
   if (whole_vertices) {
     HYPRE_BoomerAMGSetNodal(impl.amg, 1);  // Frobenius norms of the vertices' 3 × 3 blocks
-  } else if (num_functions > 1) {
-    // hypre takes the array (and frees it with the solver).
+  } else {
+    // Each row's component; hypre takes the array (and frees it with the solver).
     auto* dof_func = hypre_CTAlloc(HYPRE_Int, static_cast<std::size_t>(n), HYPRE_MEMORY_HOST);
-    std::copy(components.begin(), components.end(), dof_func);
+    for (HYPRE_BigInt i = 0; i < n; ++i)
+      dof_func[i] = static_cast<HYPRE_Int>(dofs[static_cast<std::size_t>(i)] % 3);
     HYPRE_BoomerAMGSetDofFunc(impl.amg, dof_func);
   }
   HYPRE_BoomerAMGSetStrongThreshold(impl.amg, m_options.strong_threshold);
@@ -221,6 +220,8 @@ void AlgebraicMultigrid::apply(ConstRef<VectorXd> r, VectorXd& z) const {
   if (impl.amg == nullptr)
     throw std::logic_error("algebraic multigrid: apply() before a successful setup()");
   const auto n = static_cast<HYPRE_Int>(impl.indices.size());
+  if (r.size() != n)
+    throw std::invalid_argument("algebraic multigrid: apply() to a vector of another size");
   z.resize(r.size());
   const std::lock_guard lock(hypre_mutex());
   HYPRE_IJVectorSetValues(impl.rhs->ij, n, impl.indices.data(), r.data());

@@ -39,26 +39,39 @@ struct TreeCycle final : SpdSolver::Cycle {
 /// system size; later setups keep them), the Galerkin products, Chebyshev smoothers and coarsest
 /// factorisation are those of the tree's multigrid, on TBB threads.
 struct AlgebraicCycle final : SpdSolver::Cycle {
-  AlgebraicMultigridOptions options;
+  std::vector<Index> free_dofs;  ///< of the systems; empty: every vertex whole
   std::unique_ptr<MultigridPreconditioner> cycle;
   Index rows = -1;
   double seconds = 0.0;
 
-  explicit AlgebraicCycle(std::vector<int> row_components) {
-    options.row_components = std::move(row_components);
-  }
+  explicit AlgebraicCycle(std::vector<Index> dofs) : free_dofs(std::move(dofs)) {}
   bool setup(const SparseMatrixd& A) override {
     const auto start = std::chrono::steady_clock::now();
+    bool ok = true;
     if (cycle == nullptr || rows != A.rows()) {
       cycle.reset();
+      AlgebraicMultigridOptions options;
+      // Systems whose rows are not the free DOFs given (another size) are taken as whole
+      // vertices when they can be, else as one scalar field per row.
+      if (static_cast<Index>(free_dofs.size()) == A.rows()) {
+        options.row_dofs = free_dofs;
+      } else if (A.rows() % 3 != 0) {
+        options.row_dofs.resize(static_cast<std::size_t>(A.rows()));
+        for (Index i = 0; i < A.rows(); ++i)
+          options.row_dofs[static_cast<std::size_t>(i)] = 3 * i;
+      }
       AlgebraicMultigrid amg(options);
-      if (!amg.setup(A)) return false;
-      std::vector<SparseMatrixd> prolongations = amg.prolongations();
-      if (prolongations.empty()) return false;  // too small to coarsen
-      cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations));
-      rows = A.rows();
+      ok = amg.setup(A);
+      std::vector<SparseMatrixd> prolongations;
+      if (ok) prolongations = amg.prolongations();
+      ok = ok && !prolongations.empty();  // too small to coarsen
+      if (ok) {
+        cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations));
+        rows = A.rows();
+      }
     }
-    const bool ok = cycle->setup(A);
+    ok = ok && cycle->setup(A);
+    if (!ok) cycle.reset();  // hypre's spaces of a matrix that failed are not kept
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return ok;
   }
@@ -103,9 +116,7 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
                      (requested == LinearSolverKind::automatic &&
                       static_cast<Index>(free_dofs.size()) >= kMultigridMinDofs));
   m_choose_by_size = false;
-  m_free_components.resize(free_dofs.size());
-  for (std::size_t i = 0; i < free_dofs.size(); ++i)
-    m_free_components[i] = static_cast<int>(free_dofs[i] % 3);
+  m_free_dofs = free_dofs;
   if (multigrid) {
     m_kind = LinearSolverKind::multigrid;
     m_multigrid = std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs));
@@ -121,7 +132,7 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
 
 void SpdSolver::use_algebraic_multigrid() {
   m_kind = LinearSolverKind::amg;
-  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_components);
+  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_dofs);
   m_multigrid_stale = true;
 }
 

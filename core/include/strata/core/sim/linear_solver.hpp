@@ -39,7 +39,7 @@ inline constexpr Index kMultigridMinDofs = 8000;
 /// Without coarser levels, `automatic` picks algebraic multigrid over CHOLMOD for systems of at
 /// least kAlgebraicMultigridMinDofs free DOFs whose Cholesky factorisation (CHOLMOD's symbolic
 /// analysis) costs at least kAlgebraicMultigridMinFill flops per non-zero of A: compact 3D bodies
-/// from about 40k vertices, not slender ones, whose separators stay small.
+/// from about 30k vertices (a 30³-cell cube), not slender ones, whose separators stay small.
 inline constexpr Index kAlgebraicMultigridMinDofs = 20000;
 inline constexpr double kAlgebraicMultigridMinFill = 20000.0;
 
@@ -60,7 +60,8 @@ class SpdSolver {
   /// `spaces` may be null or empty (no coarser levels): then `multigrid` is CHOLMOD and
   /// `automatic` chooses between CHOLMOD and algebraic multigrid at the first solve, by the
   /// system's size and its factorisation's cost (kAlgebraicMultigridMinFill). Without this call
-  /// the same holds.
+  /// `multigrid` is CHOLMOD, `automatic` chooses the same way, and algebraic multigrid takes the
+  /// systems' rows as whole vertices (x, y, z) where their count is a multiple of 3.
   void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs);
 
   /// Relative residual ‖b − A x‖ / ‖b‖ at which the iterative paths (CG on a previous factor,
@@ -120,7 +121,7 @@ class SpdSolver {
   bool m_multigrid_stale = true;
   double m_iterations_per_decade = -1.0;  ///< of the first solve after the last setup
   bool m_choose_by_size = false;          ///< `automatic` without nested spaces: decided at a solve
-  std::vector<int> m_free_components;  ///< component (0–2) of each free DOF; empty: interleaved
+  std::vector<Index> m_free_dofs;  ///< of the systems (use_nested_spaces); empty: whole vertices
   std::unique_ptr<Cycle> m_multigrid;
   void use_algebraic_multigrid();
   void analyze(const SparseMatrixd& A);         ///< CHOLMOD's symbolic analysis of A's pattern
