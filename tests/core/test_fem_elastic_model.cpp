@@ -226,6 +226,30 @@ TEST(ElasticModel, MinVolumeRatioFindsTheInvertedTet) {
   EXPECT_TRUE(contains_centre);
 }
 
+TEST(ElasticModel, ForcesAndMinVolumeRatioInOnePass) {
+  // Every model (lane kernels and the scalar path; 4 × 4 × 5 cells leave a partial lane group in
+  // some chunks), a smooth deformation and one with inverted tets.
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(1.0, 1.0, 1.3), {4, 4, 5});
+  for (MaterialModel material : kAllModels) {
+    const ElasticModel model(mesh.vertices, mesh.tets, test_material(material));
+    VectorXd x = model.rest_positions();
+    for (Index v = 0; v < model.num_vertices(); ++v)
+      x.segment<3>(3 * v) += 0.05 * Vector3d(std::sin(3.0 * x[3 * v + 2]), x[3 * v] * x[3 * v + 1],
+                                             std::cos(2.0 * x[3 * v]));
+    for (bool invert : {false, true}) {
+      if (invert) x.segment<3>(3 * 31) += Vector3d(0.9, 0.2, -0.4);
+      VectorXd f_plain, f_fused;
+      model.forces(x, f_plain);
+      const auto [J, tet] = model.forces_and_min_volume_ratio(x, f_fused);
+      EXPECT_EQ(f_fused, f_plain) << to_string(material);  // the same kernel, bit for bit
+      const auto [J_separate, tet_separate] = model.min_volume_ratio(x);
+      EXPECT_NEAR(J, J_separate, 1e-12) << to_string(material);
+      EXPECT_EQ(tet, tet_separate) << to_string(material);
+      EXPECT_EQ(J < 0.0, invert) << to_string(material);
+    }
+  }
+}
+
 TEST(LumpedMass, SumsToDensityTimesVolume) {
   const TetMesh mesh = irregular_box(3, 10);
   const ElasticModel model(mesh.vertices, mesh.tets, test_material(MaterialModel::stvk));

@@ -118,10 +118,16 @@ namespace {
 /// Forces (and energies) of the sorted tets [first, first + kLanes), all lanes at once.
 template <bool kWithEnergy, typename LaneKernel>
 double lane_group_forces(const LaneKernel& kernel, const double* positions, const int* tets,
-                         const double* lane_Dm_inv, const double* volume, double* forces) {
+                         const double* lane_Dm_inv, const double* volume, double* forces,
+                         double* volume_ratio) {
   using detail::kLanes;
   double F[3][3][kLanes];
   detail::lane_deformation_gradient(positions, tets, lane_Dm_inv, F);
+  if (volume_ratio != nullptr)
+    for (int l = 0; l < kLanes; ++l)
+      volume_ratio[l] = F[0][0][l] * (F[1][1][l] * F[2][2][l] - F[1][2][l] * F[2][1][l]) -
+                        F[0][1][l] * (F[1][0][l] * F[2][2][l] - F[1][2][l] * F[2][0][l]) +
+                        F[0][2][l] * (F[1][0][l] * F[2][1][l] - F[1][1][l] * F[2][0][l]);
   double P[3][3][kLanes], psi[kLanes];
   kernel.template operator()<kWithEnergy>(F, P, psi);
   // H = −V P Dm⁻ᵀ: column j is the force on vertex j + 1.
@@ -148,6 +154,21 @@ double lane_group_forces(const LaneKernel& kernel, const double* positions, cons
   return energy;
 }
 
+/// The smallest volume ratio J over tets: the smallest J wins, a NaN before any number, ties to
+/// the smaller tet index, so the answer does not depend on the schedule.
+struct SmallestVolumeRatio {
+  double J = std::numeric_limits<double>::infinity();
+  Index tet = -1;
+  bool before(const SmallestVolumeRatio& other) const {
+    if (tet < 0) return false;
+    if (other.tet < 0) return true;
+    const bool nan = std::isnan(J), other_nan = std::isnan(other.J);
+    if (nan != other_nan) return nan;
+    if (!nan && J != other.J) return J < other.J;
+    return tet < other.tet;
+  }
+};
+
 /// Tets ahead of the current lane group whose vertex data is prefetched.
 constexpr int kPrefetchTets = 32;
 
@@ -163,11 +184,14 @@ inline void prefetch_vertices(const int* tets, const double* positions, const do
 
 template <typename Kernel>
 void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
-                                     double* energy) const {
+                                     double* energy,
+                                     std::pair<double, Index>* smallest_volume_ratio) const {
   std::vector<double> chunk_energy(energy ? m_partition.num_chunks() : 0, 0.0);
+  const bool ratios = smallest_volume_ratio != nullptr;
+  std::vector<SmallestVolumeRatio> chunk_smallest(ratios ? m_partition.num_chunks() : 0);
   const double* positions = x.data();
   double* forces = f.data();
-  const auto scalar_tet = [&](int i) {
+  const auto scalar_tet = [&](int i, int chunk) {
     const int* tet = &m_sorted_tets[4 * i];
     const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
     const Matrix3d F = edge_matrix_at(positions, tet) * Dm_inv;
@@ -176,6 +200,11 @@ void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x,
     for (int k = 0; k < 3; ++k)
       Eigen::Map<Vector3d>(forces + 3 * tet[k + 1]) += H.col(k);
     Eigen::Map<Vector3d>(forces + 3 * tet[0]) -= H.rowwise().sum();
+    if (ratios) {
+      const SmallestVolumeRatio here{F.determinant(), static_cast<Index>(m_partition.order[i])};
+      SmallestVolumeRatio& best = chunk_smallest[chunk];
+      if (here.before(best)) best = here;
+    }
     return energy ? m_sorted_volume[i] * kernel.psi(F) : 0.0;
   };
   for_each_chunk_colored(m_partition, [&](int chunk) {
@@ -190,16 +219,32 @@ void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x,
         const double* lane_volume = lane_Dm_inv + 9 * detail::kLanes;
         if (i + kPrefetchTets + detail::kLanes <= end)
           prefetch_vertices(&m_sorted_tets[4 * (i + kPrefetchTets)], positions, forces);
+        double J[detail::kLanes];
+        double* volume_ratio = ratios ? J : nullptr;
         sum += energy ? lane_group_forces<true>(lanes, positions, &m_sorted_tets[4 * i],
-                                                lane_Dm_inv, lane_volume, forces)
+                                                lane_Dm_inv, lane_volume, forces, volume_ratio)
                       : lane_group_forces<false>(lanes, positions, &m_sorted_tets[4 * i],
-                                                 lane_Dm_inv, lane_volume, forces);
+                                                 lane_Dm_inv, lane_volume, forces, volume_ratio);
+        if (ratios) {
+          SmallestVolumeRatio& best = chunk_smallest[chunk];
+          for (int l = 0; l < detail::kLanes; ++l) {
+            if (J[l] > best.J) continue;  // the common case; NaNs and ties take the full rule
+            const SmallestVolumeRatio here{J[l], static_cast<Index>(m_partition.order[i + l])};
+            if (here.before(best)) best = here;
+          }
+        }
       }
     }
     for (; i < end; ++i)
-      sum += scalar_tet(i);
+      sum += scalar_tet(i, chunk);
     if (energy) chunk_energy[chunk] = sum;
   });
+  if (ratios) {
+    SmallestVolumeRatio smallest;
+    for (const SmallestVolumeRatio& candidate : chunk_smallest)
+      if (candidate.before(smallest)) smallest = candidate;
+    *smallest_volume_ratio = {smallest.J, smallest.tet};
+  }
   if (energy) {
     *energy = 0.0;
     for (double e : chunk_energy)
@@ -233,7 +278,17 @@ void ElasticModel::forces(ConstRef<VectorXd> x, VectorXd& f) const {
   check_size(x, num_dofs());
   f.setZero(num_dofs());
   dispatch_kernel(m_material.model, m_lame,
-                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, nullptr); });
+                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, nullptr, nullptr); });
+}
+
+std::pair<double, Index> ElasticModel::forces_and_min_volume_ratio(ConstRef<VectorXd> x,
+                                                                   VectorXd& f) const {
+  check_size(x, num_dofs());
+  f.setZero(num_dofs());
+  std::pair<double, Index> smallest;
+  dispatch_kernel(m_material.model, m_lame,
+                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, nullptr, &smallest); });
+  return smallest;
 }
 
 double ElasticModel::energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const {
@@ -241,7 +296,7 @@ double ElasticModel::energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const 
   f.setZero(num_dofs());
   double energy = 0.0;
   dispatch_kernel(m_material.model, m_lame,
-                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, &energy); });
+                  [&](const auto& kernel) { accumulate_forces(kernel, x, f, &energy, nullptr); });
   return energy;
 }
 
@@ -406,18 +461,7 @@ std::pair<double, Index> ElasticModel::min_volume_ratio(ConstRef<VectorXd> x) co
   check_size(x, num_dofs());
   // J = det(Ds Dm⁻¹) = det(Ds) det(Dm⁻¹), over the sorted tets in parallel. The smallest J wins,
   // a NaN before any number, ties to the smaller tet index: the same answer on any schedule.
-  struct Smallest {
-    double J = std::numeric_limits<double>::infinity();
-    Index tet = -1;
-    bool before(const Smallest& other) const {
-      if (tet < 0) return false;
-      if (other.tet < 0) return true;
-      const bool nan = std::isnan(J), other_nan = std::isnan(other.J);
-      if (nan != other_nan) return nan;
-      if (!nan && J != other.J) return J < other.J;
-      return tet < other.tet;
-    }
-  };
+  using Smallest = SmallestVolumeRatio;
   const double* p = x.data();
   const Smallest smallest = tbb::parallel_reduce(
       tbb::blocked_range<Index>(0, num_tets(), 8192), Smallest{},

@@ -20,7 +20,7 @@ DivergenceLimits default_divergence_limits(const Material& material, double diag
 
 void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<VectorXd> v,
                       const DivergenceLimits& limits, long step, double time,
-                      const std::string& context) {
+                      const std::string& context, const std::pair<double, Index>* volume_ratio) {
   const std::string where =
       context + ": step " + std::to_string(step) + ", t = " + std::to_string(time) + ": ";
   auto fail = [&](const std::string& what) { throw DivergenceError(where + what, step, time); };
@@ -54,7 +54,7 @@ void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<
          std::to_string(limits.max_displacement) + " m (100 x bounding-box diagonal)");
   }
   if (limits.check_inversion) {
-    const auto [min_j, tet] = model.min_volume_ratio(x);
+    const auto [min_j, tet] = volume_ratio != nullptr ? *volume_ratio : model.min_volume_ratio(x);
     if (!(min_j > 0.0))
       fail("element " + std::to_string(tet) + " inverted (J = " + std::to_string(min_j) + ") and " +
            to_string(model.material().model) + " cannot handle inversion");

@@ -12,7 +12,9 @@ void symplectic_euler_step(const Problem& system, double t, double h, VectorXd& 
     // targets afterwards (their accelerations do not matter).
     VectorXd local;
     VectorXd& f = scratch != nullptr ? scratch->forces : local;
-    system.internal_forces(x, f);
+    if (scratch == nullptr || !scratch->forces_current || f.size() != x.size())
+      system.internal_forces(x, f);
+    if (scratch != nullptr) scratch->forces_current = false;
     VectorXd timed_external;
     if (system.has_timed_forces()) system.external_forces_at(t, 1.0, timed_external);
     const double* f_ext =

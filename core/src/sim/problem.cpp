@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "strata/core/common/error.hpp"
+
 namespace strata {
 
 double Problem::ramp(double t) const {
@@ -40,6 +42,16 @@ void Problem::add_damping_forces(const VectorXd& x, const VectorXd& v, const Vec
 void Problem::internal_forces(const VectorXd& x, VectorXd& f_int) const {
   model.forces(x, f_int);
   if (springs != nullptr) springs->add_forces(x, f_int);
+}
+
+std::pair<double, Index> Problem::internal_forces_and_min_volume_ratio(const VectorXd& x,
+                                                                       VectorXd& f_int) const {
+  STRATA_VERIFY(model.is_identity(),
+                "Problem::internal_forces_and_min_volume_ratio needs the mesh's own DOFs");
+  const std::pair<double, Index> smallest =
+      model.mesh_model().forces_and_min_volume_ratio(x, f_int);
+  if (springs != nullptr) springs->add_forces(x, f_int);
+  return smallest;
 }
 
 void Problem::accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const {

@@ -214,7 +214,7 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
     throw InputError("initial state: positions and velocities must be finite");
   m_x = positions;
   m_v = is_static() ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
-  m_stepper->reset_history();
+  if (m_stepper) m_stepper->reset_history();
   if (is_static()) {
     apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), load_factor(), 0.0, m_x,
                     m_v);
@@ -264,8 +264,13 @@ void Simulation::advance() {
   if (m_springs) m_springs->yield(m_x);
   ++m_steps;
   if (has_obstacles()) m_contact_step = m_steps;
+  // Where the next step starts with the forces at this state, the stepper computes them now and
+  // the inversion check comes from the same pass over the tets.
+  std::optional<std::pair<double, Index>> volume_ratio;
+  if (m_limits.check_inversion && !finished()) volume_ratio = m_stepper->prepare_next_step(m_x);
   check_divergence(*m_model, positions(), is_static() ? VectorXd() : velocities(), m_limits,
-                   m_steps, time(), std::string(m_stepper_traits->name));
+                   m_steps, time(), std::string(m_stepper_traits->name),
+                   volume_ratio ? &*volume_ratio : nullptr);
 }
 
 std::vector<ContactPoint> Simulation::embed_points(const std::vector<ContactPoint>& points) const {
@@ -346,6 +351,7 @@ void Simulation::set_plastic_state(PlasticState state) {
                      " tets");
   m_plastic = std::move(state);
   m_model->set_plastic_inverse(m_plastic.plastic_inverse);
+  if (m_stepper) m_stepper->reset_history();
 }
 
 namespace {

@@ -32,6 +32,17 @@ NewtonResult SymplecticEulerStepper::step(double t0, double, double h, VectorXd&
   return explicit_result();
 }
 
+std::optional<std::pair<double, Index>> SymplecticEulerStepper::prepare_next_step(
+    const VectorXd& q) {
+  if (m_problem.mass_damping != 0.0 || m_problem.stiffness_damping != 0.0 ||
+      !m_problem.model.is_identity())
+    return std::nullopt;
+  const std::pair<double, Index> smallest =
+      m_problem.internal_forces_and_min_volume_ratio(q, m_scratch.forces);
+  m_scratch.forces_current = true;
+  return smallest;
+}
+
 NewtonResult Rk4Stepper::step(double t0, double, double h, VectorXd& q, VectorXd& v) {
   rk4_step(m_problem, t0, h, q, v);
   return explicit_result();

@@ -43,6 +43,9 @@ class ElasticModel {
   void forces(ConstRef<VectorXd> x, VectorXd& f) const;
   /// Both at once; returns Ψ(x).
   double energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const;
+  /// forces(x, f) and, from the same pass, min_volume_ratio(x) (J as det F of each tet, equal to
+  /// det(Ds) det(Dm⁻¹) up to round-off).
+  std::pair<double, Index> forces_and_min_volume_ratio(ConstRef<VectorXd> x, VectorXd& f) const;
   /// K = ∂²Ψ/∂x² in the fixed pattern of `stiffness_pattern()`; `K` is set to that pattern on the
   /// first call and only its values are rewritten afterwards. With `project_psd`, each element's
   /// ∂²ψ/∂F² is projected to PSD first (in closed form, see isotropic_hessian.hpp).
@@ -70,8 +73,8 @@ class ElasticModel {
 
  private:
   template <typename Kernel>
-  void accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f,
-                         double* energy) const;
+  void accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f, double* energy,
+                         std::pair<double, Index>* smallest_volume_ratio) const;
   void build_stiffness_pattern();
   /// Writes the kernels' rest arrays from Dm⁻¹ (and Fₚ⁻¹ if set).
   void fill_rest_arrays();

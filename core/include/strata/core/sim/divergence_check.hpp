@@ -23,9 +23,11 @@ struct DivergenceLimits {
 DivergenceLimits default_divergence_limits(const Material& material, double diagonal);
 
 /// Throws DivergenceError (step, time; `context` e.g. "rk4") if the state (x, v: 3·#V) violates a
-/// limit. `v` may be empty (static runs).
+/// limit. `v` may be empty (static runs). `volume_ratio`, when given, is model.min_volume_ratio(x)
+/// computed elsewhere (with the forces at x), used instead of a pass over the tets.
 void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<VectorXd> v,
                       const DivergenceLimits& limits, long step, double time,
-                      const std::string& context);
+                      const std::string& context,
+                      const std::pair<double, Index>* volume_ratio = nullptr);
 
 }  // namespace strata

@@ -11,6 +11,9 @@ namespace strata {
 /// Vectors an explicit step reuses from the previous one (no allocation per step).
 struct ExplicitScratch {
   VectorXd forces;
+  /// `forces` are the internal forces at the state the next step starts from (computed after the
+  /// previous step, with the inversion check): that step uses them instead of evaluating them.
+  bool forces_current = false;
 };
 
 /// Symplectic (semi-implicit) Euler from time t: v ← v + h a(x, v), then x ← x + h v.

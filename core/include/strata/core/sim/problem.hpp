@@ -75,6 +75,10 @@ struct Problem {
                           VectorXd& f) const;
   /// f_int = elastic forces (+ surface spring forces), 3·#Q.
   void internal_forces(const VectorXd& x, VectorXd& f_int) const;
+  /// internal_forces and, from the same pass over the tets, the smallest volume ratio det F and its
+  /// tet (ElasticModel::min_volume_ratio); needs model.is_identity().
+  std::pair<double, Index> internal_forces_and_min_volume_ratio(const VectorXd& x,
+                                                                VectorXd& f_int) const;
   /// a = M⁻¹ (f_int + f_ext + f_damp); at Dirichlet DOFs the prescribed acceleration at time t.
   void accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const;
 };

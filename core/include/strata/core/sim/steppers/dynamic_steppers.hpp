@@ -23,6 +23,9 @@ class SymplecticEulerStepper final : public TimeStepper {
  public:
   explicit SymplecticEulerStepper(const Problem& problem) : m_problem(problem) {}
   NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
+  void reset_history() override { m_scratch.forces_current = false; }
+  /// Without damping (one force evaluation per step, at its start) and on the mesh's own DOFs.
+  std::optional<std::pair<double, Index>> prepare_next_step(const VectorXd& q) override;
 
  private:
   const Problem& m_problem;

@@ -7,7 +7,9 @@
 /// (explicit ones). The registry (`stepper_registry`) lists every stepper with its traits; adding
 /// one touches its own file and one registration in stepper_registry.cpp.
 #include <memory>
+#include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -28,8 +30,16 @@ class TimeStepper {
   /// Re-solves the state at t (static load stepping after the state moved to a new cut); other
   /// steppers throw std::logic_error.
   virtual NewtonResult resolve(double t, VectorXd& q, VectorXd& v);
-  /// The state was replaced (initial state, a new cut): no step history carries over.
+  /// The state was replaced (initial state, a new cut, a new plastic state): no step history
+  /// carries over.
   virtual void reset_history() {}
+  /// Called with the accepted state q after a step when the next step follows and the run checks
+  /// for inverted tets: a stepper whose next step starts with the internal forces at q may compute
+  /// them now, keep them for that step, and return the smallest volume ratio det F over the tets
+  /// (with its tet) from the same pass; others return nothing and the check makes its own pass.
+  virtual std::optional<std::pair<double, Index>> prepare_next_step(const VectorXd&) {
+    return std::nullopt;
+  }
   /// The linear solver of implicit steppers; nullptr for explicit ones.
   virtual const SpdSolver* linear_solver() const { return nullptr; }
   /// The energy Newton minimises (implicit steppers); nullptr for explicit ones.
