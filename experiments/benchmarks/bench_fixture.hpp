@@ -3,6 +3,8 @@
 /// Shared set-up of the benchmarks: box meshes of ~50k and ~400k tets, a smooth deformed state and
 /// a cache holding the most recently built ElasticModel (building the stiffness pattern of the
 /// large mesh takes longer than one measurement).
+#include <sys/resource.h>
+
 #include <array>
 #include <memory>
 #include <string>
@@ -43,6 +45,24 @@ inline const std::vector<int>& thread_counts() {
 }
 
 /// "<prefix>/tets:<#T>/threads:<n>".
+/// User and system CPU seconds of the whole process so far (getrusage): differences around a
+/// timed loop give its system-time share.
+struct CpuSeconds {
+  double user = 0.0;
+  double system = 0.0;
+};
+inline CpuSeconds process_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+  return {seconds(usage.ru_utime), seconds(usage.ru_stime)};
+}
+/// System over user CPU time between two readings (0 when no user time passed).
+inline double system_share(const CpuSeconds& start, const CpuSeconds& end) {
+  const double user = end.user - start.user;
+  return user > 0.0 ? (end.system - start.system) / user : 0.0;
+}
+
 inline std::string benchmark_name(const std::string& prefix, const MeshSize& size, int threads) {
   return prefix + "/tets:" + std::to_string(size.num_tets()) +
          "/threads:" + std::to_string(threads);

@@ -126,6 +126,8 @@ TEST(SimIntegrators, ForcesPreparedAfterAStepGiveTheSameTrajectory) {
     fresh.advance();
   }
   EXPECT_EQ(prepared.positions(), fresh.positions());
+  // The kept forces were used: one force evaluation per step instead of one plus the state's.
+  EXPECT_LT(prepared.counters().element_evaluations, fresh.counters().element_evaluations);
 }
 
 TEST(SimIntegrators, StableStepEstimateIsABoundOnTheTrueLimit) {

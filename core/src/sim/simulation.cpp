@@ -332,7 +332,10 @@ double Simulation::push_out_of_obstacles(double depth) {
   const double t = is_static() ? 0.0 : time();
   m_contact->set_step(m_x, t, t);
   const double largest = m_contact->push_out(m_x, m_constrained, depth);
-  if (largest > 0.0) update_mesh_state();
+  if (largest > 0.0) {
+    update_mesh_state();
+    m_stepper->reset_history();  // forces kept for the next step were at the old positions
+  }
   return largest;
 }
 

@@ -23,8 +23,9 @@ struct DivergenceLimits {
 DivergenceLimits default_divergence_limits(const Material& material, double diagonal);
 
 /// Throws DivergenceError (step, time; `context` e.g. "rk4") if the state (x, v: 3·#V) violates a
-/// limit. `v` may be empty (static runs). `volume_ratio`, when given, is model.min_volume_ratio(x)
-/// computed elsewhere (with the forces at x), used instead of a pass over the tets.
+/// limit. `v` may be empty (static runs). `volume_ratio`, when given, is the smallest volume ratio
+/// at x computed with the forces (ElasticModel::forces_and_min_volume_ratio: det F, equal to
+/// min_volume_ratio's det(Ds) det(Dm⁻¹) up to round-off), used instead of a pass over the tets.
 void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<VectorXd> v,
                       const DivergenceLimits& limits, long step, double time,
                       const std::string& context,
