@@ -29,53 +29,39 @@ done
 [[ -x /usr/bin/time ]] || { echo "linear_solvers_without_tree: needs /usr/bin/time (package time)" >&2; exit 1; }
 mkdir -p "${out_dir}/scenes" "${out_dir}/runs"
 
-cube() {  # name cells mode
-  local solver_block
-  if [[ "$3" == static ]]; then
-    solver_block='"mode": "static", "load_steps": 3'
-  else
-    solver_block='"mode": "dynamic", "integrator": "implicit_euler", "dt": 0.001, "duration": 0.003'
-  fi
+# box_scene NAME LX LY LZ NX NY NZ E NU SOLVER_BLOCK: a StVK box [0, L] clamped at x = 0 under
+# gravity, probed at the centre of its far end.
+box_scene() {
   cat >"${out_dir}/scenes/$1.json" <<JSON
 {
-  "mesh": {"box": {"min": [0, 0, 0], "max": [1, 1, 1], "cells": [$2, $2, $2]}},
-  "material": {"model": "stvk", "youngs_modulus": 1e6, "poisson_ratio": 0.45, "density": 1000},
+  "mesh": {"box": {"min": [0, 0, 0], "max": [$2, $3, $4], "cells": [$5, $6, $7]}},
+  "material": {"model": "stvk", "youngs_modulus": $8, "poisson_ratio": $9, "density": 1000},
   "gravity": [0, 0, -9.81],
-  "fixed": [{"box": {"min": [0, 0, 0], "max": [0, 1, 1]}}],
-  "solver": {${solver_block}},
-  "output": {"probes": [[1, 0.5, 0.5]], "vtk": false}
+  "fixed": [{"box": {"min": [0, 0, 0], "max": [0, $3, $4]}}],
+  "solver": {${10}},
+  "output": {"probes": [[$2, $(awk "BEGIN{print $3/2}"), $(awk "BEGIN{print $4/2}")]], "vtk": false}
 }
 JSON
 }
-cantilever() {  # name nx mode
-  local ny=$(($2 / 10)) solver_block
-  if [[ "$3" == static ]]; then
-    solver_block='"mode": "static", "load_steps": 10'
-  else
-    solver_block='"mode": "dynamic", "integrator": "implicit_euler", "dt": 0.001, "duration": 0.01'
-  fi
-  cat >"${out_dir}/scenes/$1.json" <<JSON
-{
-  "mesh": {"box": {"min": [0, 0, 0], "max": [2, 0.2, 0.2], "cells": [$2, ${ny}, ${ny}]}},
-  "material": {"model": "stvk", "youngs_modulus": 4e7, "poisson_ratio": 0.3, "density": 1000},
-  "gravity": [0, 0, -9.81],
-  "fixed": [{"box": {"min": [0, 0, 0], "max": [0, 0.2, 0.2]}}],
-  "solver": {${solver_block}},
-  "output": {"probes": [[2, 0.1, 0.1]], "vtk": false}
+static() { echo "\"mode\": \"static\", \"load_steps\": $1"; }
+implicit() { echo "\"mode\": \"dynamic\", \"integrator\": \"implicit_euler\", \"dt\": 0.001, \"duration\": $1"; }
+cube() {  # name cells solver_block: 1 m cube, E = 1 MPa, ν = 0.45
+  box_scene "$1" 1 1 1 "$2" "$2" "$2" 1e6 0.45 "$3"
 }
-JSON
+cantilever() {  # name nx solver_block: 2 × 0.2 × 0.2 m, E = 40 MPa, ν = 0.3
+  box_scene "$1" 2 0.2 0.2 "$2" $(($2 / 10)) $(($2 / 10)) 4e7 0.3 "$3"
 }
 
 scenes=(cube20_dynamic cube30_dynamic)
-cube cube20_dynamic 20 dynamic
-cube cube30_dynamic 30 dynamic
+cube cube20_dynamic 20 "$(implicit 0.003)"
+cube cube30_dynamic 30 "$(implicit 0.003)"
 if ((quick == 0)); then
-  cube cube40_dynamic 40 dynamic
-  cube cube30_static 30 static
-  cube cube40_static 40 static
-  cantilever cantilever80_static 80 static
-  cantilever cantilever160_static 160 static
-  cantilever cantilever160_dynamic 160 dynamic
+  cube cube40_dynamic 40 "$(implicit 0.003)"
+  cube cube30_static 30 "$(static 3)"
+  cube cube40_static 40 "$(static 3)"
+  cantilever cantilever80_static 80 "$(static 10)"
+  cantilever cantilever160_static 160 "$(static 10)"
+  cantilever cantilever160_dynamic 160 "$(implicit 0.01)"
   scenes+=(cube40_dynamic cube30_static cube40_static cantilever80_static cantilever160_static
     cantilever160_dynamic)
 fi

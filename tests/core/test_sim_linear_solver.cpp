@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCholesky>
+#include <array>
 
 #include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -11,9 +12,15 @@
 namespace strata {
 namespace {
 
-/// Final positions of a clamped column under sideways gravity, solved with the given linear solver.
-VectorXd solve_column(SimulationMode mode, LinearSolverKind solver) {
-  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.2, 1.0), {2, 2, 6});
+/// A clamped column under sideways gravity, solved with the given linear solver.
+struct ColumnRun {
+  VectorXd displacement;  ///< final positions − rest
+  SimulationCounters counters;
+};
+
+ColumnRun solve_column(SimulationMode mode, LinearSolverKind solver,
+                       const std::array<int, 3>& cells = {2, 2, 6}) {
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.2, 1.0), cells);
   Material material;
   material.model = MaterialModel::neohookean;
   material.youngs_modulus = 5e5;
@@ -33,18 +40,32 @@ VectorXd solve_column(SimulationMode mode, LinearSolverKind solver) {
     sim.advance();
   EXPECT_GT(sim.counters().newton_iterations, 0);
   EXPECT_GT(sim.counters().factorizations, 0);
-  return sim.positions();
+  return {sim.positions() - flatten(mesh.vertices), sim.counters()};
 }
 
 TEST(SimLinearSolver, ConjugateGradientsMatchCholmod) {
   for (SimulationMode mode : {SimulationMode::static_equilibrium, SimulationMode::dynamic}) {
-    const VectorXd cholmod = solve_column(mode, LinearSolverKind::cholmod);
-    const VectorXd cg = solve_column(mode, LinearSolverKind::cg);
-    const VectorXd rest =
-        flatten(box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.2, 0.2, 1.0), {2, 2, 6}).vertices);
-    const double displacement = (cholmod - rest).lpNorm<Eigen::Infinity>();
+    const VectorXd cholmod = solve_column(mode, LinearSolverKind::cholmod).displacement;
+    const VectorXd cg = solve_column(mode, LinearSolverKind::cg).displacement;
+    const double displacement = cholmod.lpNorm<Eigen::Infinity>();
     EXPECT_GT(displacement, 1e-4);
     EXPECT_LT((cholmod - cg).lpNorm<Eigen::Infinity>(), 1e-7 * displacement) << to_string(mode);
+  }
+}
+
+TEST(SimLinearSolver, AlgebraicMultigridMatchesCholmod) {
+  // A finer column (1,875 DOFs): large enough for hypre to coarsen.
+  for (SimulationMode mode : {SimulationMode::static_equilibrium, SimulationMode::dynamic}) {
+    const ColumnRun direct = solve_column(mode, LinearSolverKind::cholmod, {4, 4, 20});
+    const ColumnRun amg = solve_column(mode, LinearSolverKind::amg, {4, 4, 20});
+    EXPECT_EQ(amg.counters.linear_solver, LinearSolverKind::amg) << to_string(mode);
+    EXPECT_EQ(amg.counters.multigrid_direct_fallbacks, 0) << to_string(mode);
+    EXPECT_GE(amg.counters.multigrid_setups, 1) << to_string(mode);
+    const double displacement = direct.displacement.lpNorm<Eigen::Infinity>();
+    EXPECT_GT(displacement, 1e-3);
+    EXPECT_LT((direct.displacement - amg.displacement).lpNorm<Eigen::Infinity>(),
+              1e-7 * displacement)
+        << to_string(mode);
   }
 }
 

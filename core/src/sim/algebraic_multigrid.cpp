@@ -9,7 +9,6 @@
 #include <HYPRE_IJ_mv.h>
 #include <HYPRE_parcsr_ls.h>
 #include <_hypre_parcsr_ls.h>  // hypre_ParAMGData: the number of levels
-#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <mutex>
@@ -87,7 +86,6 @@ struct AlgebraicMultigrid::Impl {
   HYPRE_Solver amg = nullptr;
   std::unique_ptr<IjVector> rhs, solution;
   std::vector<HYPRE_BigInt> indices;  ///< 0, 1, …, n − 1
-  mutable std::vector<double> buffer;
   int levels = 0;
 
   void release() {
@@ -136,7 +134,6 @@ bool AlgebraicMultigrid::setup(const SparseMatrixd& A) {
   const auto n = static_cast<HYPRE_BigInt>(A.rows());
   impl.indices.resize(static_cast<std::size_t>(n));
   std::iota(impl.indices.begin(), impl.indices.end(), HYPRE_BigInt{0});
-  impl.buffer.resize(static_cast<std::size_t>(n));
 
   // A is symmetric with both triangles stored: its columns are its rows (CSR = CSC).
   std::vector<HYPRE_Int> row_sizes(static_cast<std::size_t>(n));
@@ -225,8 +222,7 @@ void AlgebraicMultigrid::apply(ConstRef<VectorXd> r, VectorXd& z) const {
   z.resize(r.size());
   const std::lock_guard lock(hypre_mutex());
   HYPRE_IJVectorSetValues(impl.rhs->ij, n, impl.indices.data(), r.data());
-  std::fill(impl.buffer.begin(), impl.buffer.end(), 0.0);
-  HYPRE_IJVectorSetValues(impl.solution->ij, n, impl.indices.data(), impl.buffer.data());
+  HYPRE_ParVectorSetConstantValues(impl.solution->par, 0.0);
   HYPRE_BoomerAMGSolve(impl.amg, impl.par_matrix, impl.rhs->par, impl.solution->par);
   HYPRE_IJVectorGetValues(impl.solution->ij, n, impl.indices.data(), z.data());
   HYPRE_ClearAllErrors();  // a cycle that did not "converge" in its single iteration is expected

@@ -50,16 +50,13 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
     bool ok = true;
     if (cycle == nullptr || rows != A.rows()) {
       cycle.reset();
+      // Rows that are not the free DOFs given (another size) are taken as whole vertices; a
+      // system that cannot be is left to CHOLMOD (setup fails).
       AlgebraicMultigridOptions options;
-      // Systems whose rows are not the free DOFs given (another size) are taken as whole
-      // vertices when they can be, else as one scalar field per row.
-      if (static_cast<Index>(free_dofs.size()) == A.rows()) {
+      if (static_cast<Index>(free_dofs.size()) == A.rows())
         options.row_dofs = free_dofs;
-      } else if (A.rows() % 3 != 0) {
-        options.row_dofs.resize(static_cast<std::size_t>(A.rows()));
-        for (Index i = 0; i < A.rows(); ++i)
-          options.row_dofs[static_cast<std::size_t>(i)] = 3 * i;
-      }
+      else if (A.rows() % 3 != 0)
+        return false;
       AlgebraicMultigrid amg(options);
       ok = amg.setup(A);
       std::vector<SparseMatrixd> prolongations;

@@ -214,7 +214,7 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
     throw InputError("initial state: positions and velocities must be finite");
   m_x = positions;
   m_v = is_static() ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
-  if (m_stepper) m_stepper->reset_history();
+  m_stepper->reset_history();
   if (is_static()) {
     apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), load_factor(), 0.0, m_x,
                     m_v);
@@ -354,7 +354,7 @@ void Simulation::set_plastic_state(PlasticState state) {
                      " tets");
   m_plastic = std::move(state);
   m_model->set_plastic_inverse(m_plastic.plastic_inverse);
-  if (m_stepper) m_stepper->reset_history();
+  if (m_stepper) m_stepper->reset_history();  // the constructor sets it before the stepper exists
 }
 
 namespace {

@@ -61,7 +61,8 @@ class SpdSolver {
   /// `automatic` chooses between CHOLMOD and algebraic multigrid at the first solve, by the
   /// system's size and its factorisation's cost (kAlgebraicMultigridMinFill). Without this call
   /// `multigrid` is CHOLMOD, `automatic` chooses the same way, and algebraic multigrid takes the
-  /// systems' rows as whole vertices (x, y, z) where their count is a multiple of 3.
+  /// systems' rows as whole vertices (x, y, z); a system whose row count is not a multiple of 3
+  /// then goes to CHOLMOD.
   void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs);
 
   /// Relative residual ‖b − A x‖ / ‖b‖ at which the iterative paths (CG on a previous factor,
