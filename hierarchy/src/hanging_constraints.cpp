@@ -1,5 +1,7 @@
 #include "strata/hierarchy/hanging_constraints.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <utility>
 
@@ -26,16 +28,16 @@ SparseMatrixd kronecker_identity3(const SparseMatrixd& C) {
   return P;
 }
 
-// Walks the mesh vertices on the boundary of one active tet (not its corners) and records them as
-// hanging on it.
+// Walks the mesh vertices on the boundary of one active tet (not its corners) and records each
+// as (mesh vertex, tet's node), in walk order.
 class BoundaryWalker {
  public:
-  BoundaryWalker(const TetTree& tree, const FlatTreeMesh& flat, std::vector<NodeId>& host)
-      : m_tree(tree), m_mesh_vertices(flat.mesh_vertices), m_host(host) {}
+  using Record = std::pair<int, NodeId>;
+  BoundaryWalker(const TetTree& tree, const FlatTreeMesh& flat, std::vector<Record>& records)
+      : m_tree(tree), m_mesh_vertices(flat.mesh_vertices), m_records(records) {}
 
   void walk(NodeId node) {
     m_node = node;
-    m_level = m_tree.level(node);
     const std::array<int, 4>& v = m_tree.bey_vertices(node);
     for (const auto& e : kTetEdges)
       walk_edge(v[e[0]], v[e[1]]);
@@ -77,16 +79,12 @@ class BoundaryWalker {
            m_mesh_vertices[tree_vertex] >= 0;
   }
 
-  void record(int tree_vertex) {
-    NodeId& host = m_host[m_mesh_vertices[tree_vertex]];
-    if (host == kNoNode || m_tree.level(host) > m_level) host = m_node;
-  }
+  void record(int tree_vertex) { m_records.emplace_back(m_mesh_vertices[tree_vertex], m_node); }
 
   const TetTree& m_tree;
   const std::vector<int>& m_mesh_vertices;
-  std::vector<NodeId>& m_host;
+  std::vector<Record>& m_records;
   NodeId m_node = kNoNode;
-  int m_level = 0;
 };
 
 }  // namespace
@@ -95,10 +93,20 @@ std::vector<HangingVertex> find_hanging_vertices(const TetTree& tree, const Flat
   const auto num_vertices = static_cast<std::size_t>(flat.mesh.vertices.rows());
   STRATA_VERIFY(flat.tree_vertices.size() == num_vertices,
                 "find_hanging_vertices: flat mesh and its vertex map disagree");
+  // Walks in parallel over fixed chunks of tets; a vertex's host is the coarsest tet it lies on,
+  // the first in tet order among equals.
+  const auto num_tets = static_cast<Index>(flat.tet_nodes.size());
+  const Index num_chunks = std::clamp<Index>(num_tets / 1024, 1, 256);
+  std::vector<std::vector<BoundaryWalker::Record>> records(num_chunks);
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    BoundaryWalker walker(tree, flat, records[c]);
+    for (Index t = num_tets * c / num_chunks; t < num_tets * (c + 1) / num_chunks; ++t)
+      walker.walk(flat.tet_nodes[t]);
+  });
   std::vector<NodeId> host(num_vertices, kNoNode);
-  BoundaryWalker walker(tree, flat, host);
-  for (const NodeId n : flat.tet_nodes)
-    walker.walk(n);
+  for (const auto& chunk : records)
+    for (const auto& [v, node] : chunk)
+      if (host[v] == kNoNode || tree.level(host[v]) > tree.level(node)) host[v] = node;
 
   std::vector<HangingVertex> hanging;
   for (std::size_t v = 0; v < num_vertices; ++v) {

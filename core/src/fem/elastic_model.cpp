@@ -19,6 +19,7 @@
 #include "strata/core/fem/isotropic_hessian.hpp"
 #include "strata/core/fem/isotropic_stress.hpp"
 #include "strata/core/fem/stvk.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
 
 namespace strata {
 
@@ -302,51 +303,44 @@ double ElasticModel::energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const 
 
 void ElasticModel::build_stiffness_pattern() {
   const Index num_tets = m_tets.rows();
-  // Vertex adjacency (including self), as sorted unique neighbour lists per column vertex.
-  std::vector<std::vector<int>> neighbours(m_num_vertices);
-  for (Index t = 0; t < num_tets; ++t)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        neighbours[m_tets(t, b)].push_back(m_tets(t, a));
-  std::vector<int> outer(3 * m_num_vertices + 1, 0);
-  Index nnz = 0;
-  for (Index v = 0; v < m_num_vertices; ++v) {
-    auto& list = neighbours[v];
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    for (int c = 0; c < 3; ++c) {
-      outer[3 * v + c] = static_cast<int>(nnz);
-      nnz += 3 * static_cast<Index>(list.size());
-    }
-  }
-  outer[3 * m_num_vertices] = static_cast<int>(nnz);
+  // Column 3v + c holds, for each neighbour w of v (ascending), the rows 3w, 3w + 1, 3w + 2.
+  const CompressedLists neighbours = vertex_neighbours(m_tets, m_num_vertices);
+
+  const Index nnz = 9 * static_cast<Index>(neighbours.indices.size());
   if (nnz > std::numeric_limits<int>::max())
     throw InputError("mesh too large: stiffness matrix exceeds 2^31 entries");
-
+  auto column_start = [&](Index v, int c) {
+    return static_cast<int>(9 * neighbours.offsets[v] + 3 * c * neighbours.list_size(v));
+  };
   m_pattern.resize(num_dofs(), num_dofs());
   m_pattern.resizeNonZeros(nnz);
-  std::copy(outer.begin(), outer.end(), m_pattern.outerIndexPtr());
-  for (Index v = 0; v < m_num_vertices; ++v)
+  int* outer = m_pattern.outerIndexPtr();
+  int* inner = m_pattern.innerIndexPtr();
+  outer[3 * m_num_vertices] = static_cast<int>(nnz);
+  tbb::parallel_for(Index(0), m_num_vertices, [&](Index v) {
     for (int c = 0; c < 3; ++c) {
-      int position = outer[3 * v + c];
-      for (int row_vertex : neighbours[v])
+      int position = outer[3 * v + c] = column_start(v, c);
+      for (const int row_vertex : neighbours[v])
         for (int r = 0; r < 3; ++r)
-          m_pattern.innerIndexPtr()[position++] = 3 * row_vertex + r;
+          inner[position++] = 3 * row_vertex + r;
+      std::fill(m_pattern.valuePtr() + column_start(v, c), m_pattern.valuePtr() + position, 0.0);
     }
-  std::fill(m_pattern.valuePtr(), m_pattern.valuePtr() + nnz, 0.0);
+  });
 
   m_block_offsets.resize(48 * num_tets);
-  for (Index i = 0; i < num_tets; ++i) {
+  tbb::parallel_for(Index(0), num_tets, [&](Index i) {
     const int* tet = &m_sorted_tets[4 * i];
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        const auto& list = neighbours[tet[b]];
-        const int slot =
-            static_cast<int>(std::lower_bound(list.begin(), list.end(), tet[a]) - list.begin());
+    for (int b = 0; b < 4; ++b) {
+      // The slot of each corner a in b's neighbour list: the count of smaller neighbours.
+      int slot[4] = {0, 0, 0, 0};
+      for (const int neighbour : neighbours[tet[b]])
+        for (int a = 0; a < 4; ++a)
+          slot[a] += neighbour < tet[a];
+      for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 3; ++c)
-          m_block_offsets[48 * i + 12 * a + 3 * b + c] = outer[3 * tet[b] + c] + 3 * slot;
-      }
-  }
+          m_block_offsets[48 * i + 12 * a + 3 * b + c] = column_start(tet[b], c) + 3 * slot[a];
+    }
+  });
 }
 
 namespace {

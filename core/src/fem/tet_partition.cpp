@@ -1,6 +1,7 @@
 #include "strata/core/fem/tet_partition.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -37,8 +38,9 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
   // Morton order of the tet centroids.
   const Vector3d lower = positions.colwise().minCoeff().transpose();
   const Vector3d extent = (positions.colwise().maxCoeff().transpose() - lower).cwiseMax(1e-300);
-  std::vector<std::uint64_t> code(num_tets);
-  for (Index t = 0; t < num_tets; ++t) {
+  // (code, tet) pairs: sorting them orders ties by tet index, as a stable sort by code would.
+  std::vector<std::pair<std::uint64_t, int>> keyed(num_tets);
+  tbb::parallel_for(Index(0), num_tets, [&](Index t) {
     Vector3d centroid = Vector3d::Zero();
     for (int k = 0; k < 4; ++k)
       centroid += positions.row(tets(t, k)).transpose();
@@ -48,10 +50,11 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
       const auto cell = static_cast<std::uint64_t>(std::clamp(unit[axis], 0.0, 1.0) * 2097151.0);
       key |= spread_bits(cell) << axis;
     }
-    code[t] = key;
-  }
-  std::stable_sort(partition.order.begin(), partition.order.end(),
-                   [&](int a, int b) { return code[a] < code[b]; });
+    keyed[t] = {key, static_cast<int>(t)};
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  for (Index i = 0; i < num_tets; ++i)
+    partition.order[i] = keyed[i].second;
 
   // Contiguous chunks of at least 256 tets, a multiple of 8 so that vectorised kernels see whole
   // lane groups (all chunks but the last).

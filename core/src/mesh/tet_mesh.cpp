@@ -1,5 +1,7 @@
 #include "strata/core/mesh/tet_mesh.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -98,34 +100,76 @@ Index remove_unreferenced_vertices(TetMesh& mesh) {
 MatrixX3i boundary_faces(const MatrixX4i& tets) {
   // Outward faces of a positively oriented tet (0, 1, 2, 3).
   static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-  struct Face {
-    std::array<int, 3> key;
-    std::array<int, 3> oriented;
+  const Index num_faces = 4 * tets.rows();
+  const Index num_vertices = tets.size() > 0 ? Index(tets.maxCoeff()) + 1 : 0;
+  // Faces bucketed by their smallest vertex (a counting sort), each bucket sorted by the other
+  // two: the faces in the order of their sorted vertex triples.
+  auto face_vertex = [&](Index f, int k) { return tets(f / 4, kFaces[f % 4][k]); };
+  auto smallest = [&](Index f) {
+    return std::min({face_vertex(f, 0), face_vertex(f, 1), face_vertex(f, 2)});
   };
-  std::vector<Face> faces;
-  faces.reserve(4 * tets.rows());
-  for (Index t = 0; t < tets.rows(); ++t) {
-    for (const auto& local : kFaces) {
-      Face face;
-      face.oriented = {tets(t, local[0]), tets(t, local[1]), tets(t, local[2])};
-      face.key = face.oriented;
-      std::sort(face.key.begin(), face.key.end());
-      faces.push_back(face);
+  std::vector<Index> bucket_start(num_vertices + 1, 0);
+  for (Index f = 0; f < num_faces; ++f)
+    ++bucket_start[smallest(f) + 1];
+  for (Index v = 0; v < num_vertices; ++v)
+    bucket_start[v + 1] += bucket_start[v];
+  struct Face {
+    std::array<int, 2> rest;  ///< the two larger vertices, ascending
+    Index face;
+  };
+  std::vector<Face> faces(num_faces);
+  {
+    std::vector<Index> next(bucket_start.begin(), bucket_start.end() - 1);
+    for (Index f = 0; f < num_faces; ++f) {
+      std::array<int, 3> key = {face_vertex(f, 0), face_vertex(f, 1), face_vertex(f, 2)};
+      std::sort(key.begin(), key.end());
+      faces[next[key[0]]++] = {{key[1], key[2]}, f};
     }
   }
-  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) { return a.key < b.key; });
-  std::vector<std::array<int, 3>> boundary;
-  for (std::size_t i = 0; i < faces.size();) {
-    std::size_t j = i + 1;
-    while (j < faces.size() && faces[j].key == faces[i].key)
-      ++j;
-    if (j - i == 1) boundary.push_back(faces[i].oriented);
-    i = j;
-  }
-  MatrixX3i result(boundary.size(), 3);
-  for (std::size_t f = 0; f < boundary.size(); ++f)
-    result.row(f) << boundary[f][0], boundary[f][1], boundary[f][2];
+  std::vector<char> boundary(num_faces, 0);
+  tbb::parallel_for(Index(0), num_vertices, [&](Index v) {
+    const auto begin = faces.begin() + bucket_start[v], end = faces.begin() + bucket_start[v + 1];
+    std::sort(begin, end, [](const Face& a, const Face& b) { return a.rest < b.rest; });
+    for (auto i = begin; i != end;) {
+      auto j = i + 1;
+      while (j != end && j->rest == i->rest)
+        ++j;
+      if (j - i == 1) boundary[i - faces.begin()] = 1;
+      i = j;
+    }
+  });
+  MatrixX3i result(std::count(boundary.begin(), boundary.end(), 1), 3);
+  Index row = 0;
+  for (Index i = 0; i < num_faces; ++i)
+    if (boundary[i]) {
+      const Index f = faces[i].face;
+      result.row(row++) << face_vertex(f, 0), face_vertex(f, 1), face_vertex(f, 2);
+    }
   return result;
+}
+
+CompressedLists vertex_tets(const MatrixX4i& tets, Index num_vertices) {
+  CompressedLists tet_lists;
+  tet_lists.offsets.resize(tets.rows() + 1);
+  tet_lists.indices.resize(4 * tets.rows());
+  for (Index t = 0; t < tets.rows(); ++t) {
+    tet_lists.offsets[t + 1] = 4 * (t + 1);
+    for (int k = 0; k < 4; ++k) {
+      STRATA_VERIFY(tets(t, k) >= 0 && tets(t, k) < num_vertices,
+                    "vertex_tets: tet " + std::to_string(t) + " has a vertex out of range");
+      tet_lists.indices[4 * t + k] = tets(t, k);
+    }
+  }
+  return transpose_lists(tet_lists, num_vertices);
+}
+
+CompressedLists vertex_neighbours(const MatrixX4i& tets, Index num_vertices) {
+  const CompressedLists incident = vertex_tets(tets, num_vertices);
+  return sorted_unique_lists(num_vertices, num_vertices, [&](Index v, std::vector<int>& out) {
+    for (const int t : incident[v])
+      for (int k = 0; k < 4; ++k)
+        out.push_back(tets(t, k));
+  });
 }
 
 std::pair<Vector3d, Vector3d> bounding_box(ConstRef<MatrixX3d> points) {

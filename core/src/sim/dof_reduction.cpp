@@ -1,5 +1,9 @@
 #include "strata/core/sim/dof_reduction.hpp"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
 #include "strata/core/common/error.hpp"
 
 namespace strata {
@@ -14,25 +18,36 @@ DofReduction::DofReduction(const SparseMatrixd& pattern, const std::vector<char>
     reduced_index[i] = static_cast<Index>(m_free.size());
     m_free.push_back(static_cast<Index>(i));
   }
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (Index col = 0; col < pattern.outerSize(); ++col) {
-    if (reduced_index[col] < 0) continue;
-    for (SparseMatrixd::InnerIterator it(pattern, col); it; ++it) {
-      if (reduced_index[it.row()] < 0) continue;
-      // Store the full value index (+1, so no value is zero) to recover the map after compression.
-      const Index value_index = &it.valueRef() - pattern.valuePtr();
-      triplets.emplace_back(reduced_index[it.row()], reduced_index[col],
-                            static_cast<double>(value_index + 1));
-    }
-  }
+  // Removing rows and columns keeps each column's rows ascending: the reduced pattern is the
+  // full one filtered, with the source of every value kept.
   m_reduced_pattern.resize(num_free(), num_free());
-  m_reduced_pattern.setFromTriplets(triplets.begin(), triplets.end());
-  m_reduced_pattern.makeCompressed();
-  m_source.resize(m_reduced_pattern.nonZeros());
-  for (Index k = 0; k < m_reduced_pattern.nonZeros(); ++k) {
-    m_source[k] = static_cast<Index>(m_reduced_pattern.valuePtr()[k]) - 1;
-    m_reduced_pattern.valuePtr()[k] = 0.0;
-  }
+  const int* full_outer = pattern.outerIndexPtr();
+  const int* full_inner = pattern.innerIndexPtr();
+  int* outer = m_reduced_pattern.outerIndexPtr();
+  outer[0] = 0;
+  tbb::parallel_for(Index(0), num_free(), [&](Index c) {
+    int count = 0;
+    for (Index p = full_outer[m_free[c]]; p < full_outer[m_free[c] + 1]; ++p)
+      count += reduced_index[full_inner[p]] >= 0;
+    outer[c + 1] = count;
+  });
+  for (Index c = 0; c < num_free(); ++c)
+    outer[c + 1] += outer[c];
+  const Index nnz = outer[num_free()];
+  m_reduced_pattern.resizeNonZeros(nnz);
+  m_source.resize(nnz);
+  int* inner = m_reduced_pattern.innerIndexPtr();
+  double* values = m_reduced_pattern.valuePtr();
+  tbb::parallel_for(Index(0), num_free(), [&](Index c) {
+    Index k = outer[c];
+    for (Index p = full_outer[m_free[c]]; p < full_outer[m_free[c] + 1]; ++p) {
+      const Index row = reduced_index[full_inner[p]];
+      if (row < 0) continue;
+      inner[k] = static_cast<int>(row);
+      values[k] = 0.0;
+      m_source[k++] = p;
+    }
+  });
   m_full_nonzeros = pattern.nonZeros();
 }
 

@@ -1,9 +1,15 @@
 #include "strata/core/sim/embedded_model.hpp"
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <string>
 
+#include "strata/core/common/compressed_lists.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
 
@@ -144,54 +150,93 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   // neighbour v of w. A block (v, w) feeds the reduced blocks (a, b) for C_va ≠ 0, C_wb ≠ 0 with
   // weight C_va C_wb, column by column (3 contiguous values each).
   const SparseMatrixd& mesh_pattern = m_model->stiffness_pattern();
+  const int* mesh_outer = mesh_pattern.outerIndexPtr();
+  const int* mesh_inner = mesh_pattern.innerIndexPtr();
   using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
   const RowMajor C_rows = m_C;
+  const int* row_outer = C_rows.outerIndexPtr();
+  const int* row_inner = C_rows.innerIndexPtr();
+  const double* row_values = C_rows.valuePtr();
 
-  // Block pattern of the reduced matrix.
-  std::vector<Eigen::Triplet<double>> triplets;
-  const Index num_mesh_vertices = m_C.rows();
-  for (Index w = 0; w < num_mesh_vertices; ++w) {
-    const Index column = 3 * w;
-    for (SparseMatrixd::InnerIterator it(mesh_pattern, column); it; ++it) {
-      if (it.row() % 3 != 0) continue;
-      const Index v = it.row() / 3;
-      for (RowMajor::InnerIterator a(C_rows, v); a; ++a)
-        for (RowMajor::InnerIterator b(C_rows, w); b; ++b)
-          triplets.emplace_back(a.col(), b.col(), 1.0);
-    }
-  }
-  SparseMatrixd blocks(m_num_dof_vertices, m_num_dof_vertices);
-  blocks.setFromTriplets(triplets.begin(), triplets.end());
-  triplets.clear();
-  triplets.reserve(static_cast<size_t>(blocks.nonZeros()) * 9);
-  for (Index b = 0; b < blocks.outerSize(); ++b)
-    for (SparseMatrixd::InnerIterator it(blocks, b); it; ++it)
-      for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i)
-          triplets.emplace_back(3 * it.row() + i, 3 * b + j, 0.0);
-  m_pattern.resize(num_dofs(), num_dofs());
-  m_pattern.setFromTriplets(triplets.begin(), triplets.end());
-  m_pattern.makeCompressed();
+  // Block pattern: the reduced neighbours a of DOF vertex b.
+  const CompressedLists blocks = sorted_unique_lists(
+      m_num_dof_vertices, m_num_dof_vertices, [&](Index b, std::vector<int>& out) {
+        for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
+          for (int k = mesh_outer[3 * w.row()]; k < mesh_outer[3 * w.row() + 1]; k += 3) {
+            const int v = mesh_inner[k] / 3;
+            out.insert(out.end(), row_inner + row_outer[v], row_inner + row_outer[v + 1]);
+          }
+      });
 
-  // Value offset of the first row of block a in reduced column c.
-  auto reduced_offset = [&](Index a, Index column) {
-    const int* begin = m_pattern.innerIndexPtr() + m_pattern.outerIndexPtr()[column];
-    const int* end = m_pattern.innerIndexPtr() + m_pattern.outerIndexPtr()[column + 1];
-    const int* found = std::lower_bound(begin, end, static_cast<int>(3 * a));
-    return static_cast<Index>(found - m_pattern.innerIndexPtr());
+  const Index nnz = 9 * static_cast<Index>(blocks.indices.size());
+  if (nnz > std::numeric_limits<int>::max())
+    throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
+  // Column 3b + j holds, for each block row a of b (ascending), the rows 3a, 3a + 1, 3a + 2.
+  auto column_start = [&](Index b, int j) {
+    return 9 * blocks.offsets[b] + 3 * j * blocks.list_size(b);
   };
-  m_terms.clear();
-  for (Index w = 0; w < num_mesh_vertices; ++w)
+  m_pattern.resize(num_dofs(), num_dofs());
+  m_pattern.resizeNonZeros(nnz);
+  int* outer = m_pattern.outerIndexPtr();
+  int* inner = m_pattern.innerIndexPtr();
+  outer[3 * m_num_dof_vertices] = static_cast<int>(nnz);
+  tbb::parallel_for(Index(0), m_num_dof_vertices, [&](Index b) {
     for (int j = 0; j < 3; ++j) {
-      const Index column = 3 * w + j;
-      for (Index k = mesh_pattern.outerIndexPtr()[column];
-           k < mesh_pattern.outerIndexPtr()[column + 1]; k += 3) {
-        const Index v = mesh_pattern.innerIndexPtr()[k] / 3;
-        for (RowMajor::InnerIterator a(C_rows, v); a; ++a)
-          for (RowMajor::InnerIterator b(C_rows, w); b; ++b)
-            m_terms.push_back({reduced_offset(a.col(), 3 * b.col() + j), k, a.value() * b.value()});
-      }
+      Index position = outer[3 * b + j] = static_cast<int>(column_start(b, j));
+      for (const int a : blocks[b])
+        for (int i = 0; i < 3; ++i)
+          inner[position++] = 3 * a + i;
+      std::fill(m_pattern.valuePtr() + column_start(b, j), m_pattern.valuePtr() + position, 0.0);
     }
+  });
+
+  // Terms in the order of the mesh pattern's columns (w, j), then its blocks, then C's entries.
+  const Index num_mesh_vertices = m_C.rows();
+  std::vector<Index> first_term(num_mesh_vertices + 1, 0);
+  tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+    Index count = 0;
+    for (int k = mesh_outer[3 * w]; k < mesh_outer[3 * w + 1]; k += 3) {
+      const int v = mesh_inner[k] / 3;
+      count += row_outer[v + 1] - row_outer[v];
+    }
+    first_term[w + 1] = 3 * count * (row_outer[w + 1] - row_outer[w]);
+  });
+  for (Index w = 0; w < num_mesh_vertices; ++w)
+    first_term[w + 1] += first_term[w];
+
+  m_terms.resize(first_term[num_mesh_vertices]);
+  // Per thread, the slot of each block row in the list of a DOF vertex b (for w with C_w = e_b).
+  tbb::enumerable_thread_specific<std::vector<int>> slots_of(
+      [&] { return std::vector<int>(m_num_dof_vertices, -1); });
+  tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+    const bool single = row_outer[w + 1] - row_outer[w] == 1;
+    std::vector<int>& slot_of = slots_of.local();
+    if (single) {
+      const std::span<const int> list = blocks[row_inner[row_outer[w]]];
+      for (std::size_t slot = 0; slot < list.size(); ++slot)
+        slot_of[list[slot]] = static_cast<int>(slot);
+    }
+    Index position = first_term[w];
+    for (int j = 0; j < 3; ++j)
+      for (int k = mesh_outer[3 * w + j]; k < mesh_outer[3 * w + j + 1]; k += 3) {
+        const int v = mesh_inner[k] / 3;
+        for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia) {
+          const int a = row_inner[ia];
+          for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib) {
+            const int b = row_inner[ib];
+            Index slot;
+            if (single) {
+              slot = slot_of[a];
+            } else {
+              const std::span<const int> list = blocks[b];
+              slot = std::lower_bound(list.begin(), list.end(), a) - list.begin();
+            }
+            m_terms[position++] = {column_start(b, j) + 3 * slot, k,
+                                   row_values[ia] * row_values[ib]};
+          }
+        }
+      }
+  });
 }
 
 }  // namespace strata

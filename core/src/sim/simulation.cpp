@@ -55,7 +55,6 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
         *m_model, std::move(options.vertex_embedding), std::move(options.dof_vertices));
   const Index num_vertices = m_mesh.vertices.rows();
   const Index num_dof_vertices = m_embedded->num_dof_vertices();
-  m_boundary = boundary_faces(m_mesh.tets);
   m_vertex_mass = lumped_vertex_mass(m_model->rest_data().rest_volume, m_mesh.tets, num_vertices,
                                      m_material.density);
   m_dof_vertex_mass = m_embedded->reduce_vertex_scalar(m_vertex_mass);
@@ -68,7 +67,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   m_groups = resolve_dirichlet_groups(dirichlet, dof_rest, tolerance);
   m_constrained = dirichlet_dof_mask(m_groups, num_dof_vertices);
   ExternalLoads mesh_loads =
-      external_loads(m_mesh.vertices, m_boundary, m_vertex_mass, gravity, loads, tolerance);
+      external_loads(m_mesh.vertices, loads.empty() ? MatrixX3i() : boundary(), m_vertex_mass,
+                     gravity, loads, tolerance);
   VectorXd& mesh_external = mesh_loads.base;
   if (options.extra_mesh_forces.size() > 0) {
     if (options.extra_mesh_forces.size() != mesh_external.size() ||
@@ -87,8 +87,6 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   }
   for (const TimedForces& timed : mesh_loads.timed)
     m_timed.push_back({timed.amplitude, m_embedded->reduce(timed.forces)});
-  m_stable_dt =
-      stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
   m_limits = default_divergence_limits(m_material, m_diagonal);
   if (m_ground)
     m_ground_stiffness =
@@ -114,7 +112,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     if (!m_embedded->is_identity())
       throw InputError("material.surface_springs: not supported on a mesh with hanging vertices");
     m_springs =
-        std::make_unique<SurfaceSprings>(m_mesh.vertices, m_boundary, *options.surface_springs);
+        std::make_unique<SurfaceSprings>(m_mesh.vertices, boundary(), *options.surface_springs);
   }
   ContactSettings contact;
   if (!options.obstacles.empty()) {
@@ -125,9 +123,10 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     // the DOFs through the embedding's rows (a hanging vertex by its constraint).
     std::vector<ContactPoint> mesh_points;
     std::vector<char> on_boundary(num_vertices, 0);
-    for (Index f = 0; f < m_boundary.rows(); ++f)
+    const MatrixX3i& faces = boundary();
+    for (Index f = 0; f < faces.rows(); ++f)
       for (int k = 0; k < 3; ++k)
-        on_boundary[m_boundary(f, k)] = 1;
+        on_boundary[faces(f, k)] = 1;
     for (Index v = 0; v < num_vertices; ++v)
       if (on_boundary[v]) mesh_points.push_back({{static_cast<int>(v)}, {1.0}});
     for (const ContactPoint& point : options.contact_points) {
@@ -188,6 +187,18 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     m_contact->set_step(m_x, t, t);
     m_contact->require_feasible(m_x, "contact point");
   }
+}
+
+const MatrixX3i& Simulation::boundary() const {
+  if (!m_boundary) m_boundary = boundary_faces(m_mesh.tets);
+  return *m_boundary;
+}
+
+double Simulation::stable_dt_estimate() const {
+  if (!m_stable_dt)
+    m_stable_dt =
+        stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
+  return *m_stable_dt;
 }
 
 const ContactSettings& Simulation::contact_settings() const {

@@ -4,6 +4,7 @@
 #include <array>
 #include <string>
 
+#include "strata/core/common/compressed_lists.hpp"
 #include "strata/core/common/types.hpp"
 
 namespace strata {
@@ -41,6 +42,13 @@ Index remove_unreferenced_vertices(TetMesh& mesh);
 /// Boundary triangles: tet faces used by exactly one tet, ordered so that their normal
 /// (x1−x0)×(x2−x0) points out of the mesh. #F × 3. Requires positively oriented tets.
 MatrixX3i boundary_faces(const MatrixX4i& tets);
+
+/// For each of `num_vertices` vertices, the tets that use it, ascending.
+CompressedLists vertex_tets(const MatrixX4i& tets, Index num_vertices);
+
+/// For each of `num_vertices` vertices, the vertices that share a tet with it (itself included if
+/// it is in a tet), ascending: the block pattern of a stiffness matrix.
+CompressedLists vertex_neighbours(const MatrixX4i& tets, Index num_vertices);
 
 /// Axis-aligned bounding box of a point set: (min, max).
 std::pair<Vector3d, Vector3d> bounding_box(ConstRef<MatrixX3d> points);

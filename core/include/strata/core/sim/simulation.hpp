@@ -172,9 +172,8 @@ class Simulation final : public SimulationRun {
   long step_count() const { return m_steps; }
 
   /// Largest stable step of the chosen integrator [s], a guaranteed bound for the problem
-  /// linearised at rest (stable_time_step.hpp); reported, never
-  /// applied.
-  double stable_dt_estimate() const { return m_stable_dt; }
+  /// linearised at rest (stable_time_step.hpp); reported, never applied. Computed on first use.
+  double stable_dt_estimate() const;
 
   std::vector<GroupReaction> reactions() const;
   double kinetic_energy() const;  ///< ½ v_qᵀ M_q v_q [J]
@@ -197,7 +196,7 @@ class Simulation final : public SimulationRun {
   const SolverSettings& settings() const { return m_settings; }
   /// Groups with DOF-vertex indices (= mesh vertices without an embedding).
   const std::vector<DirichletGroup>& dirichlet_groups() const { return m_groups; }
-  const MatrixX3i& boundary() const { return m_boundary; }       ///< boundary triangles #F × 3
+  const MatrixX3i& boundary() const;  ///< boundary triangles #F × 3 (found on first use)
   const VectorXd& vertex_mass() const { return m_vertex_mass; }  ///< mesh, #V [kg]
   /// Lumped masses of the DOF vertices, Cᵀ m (#Q) [kg].
   const VectorXd& dof_vertex_mass() const { return m_dof_vertex_mass; }
@@ -263,7 +262,7 @@ class Simulation final : public SimulationRun {
   SolverSettings m_settings;
   std::unique_ptr<ElasticModel> m_model;
   std::unique_ptr<EmbeddedElasticModel> m_embedded;
-  MatrixX3i m_boundary;
+  mutable std::optional<MatrixX3i> m_boundary;
   VectorXd m_vertex_mass;
   VectorXd m_dof_vertex_mass;
   VectorXd m_dof_mass;
@@ -274,7 +273,7 @@ class Simulation final : public SimulationRun {
   std::optional<GroundPlane> m_ground;
   double m_ground_stiffness = 0.0;
   double m_diagonal = 0.0;
-  double m_stable_dt = 0.0;
+  mutable std::optional<double> m_stable_dt;
   DivergenceLimits m_limits;
   NestedSpaces m_nested;
   std::unique_ptr<Problem> m_system;

@@ -1,0 +1,35 @@
+#pragma once
+/// \file compressed_lists.hpp
+/// Many short integer lists stored back to back (the layout of a compressed sparse column
+/// pattern): list i holds `indices[offsets[i] .. offsets[i + 1])`.
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "strata/core/common/types.hpp"
+
+namespace strata {
+
+struct CompressedLists {
+  std::vector<Index> offsets{0};  ///< size() + 1 entries, offsets[0] = 0
+  std::vector<int> indices;
+
+  Index size() const { return static_cast<Index>(offsets.size()) - 1; }
+  Index list_size(Index i) const { return offsets[i + 1] - offsets[i]; }
+  std::span<const int> operator[](Index i) const {
+    return {indices.data() + offsets[i], static_cast<std::size_t>(list_size(i))};
+  }
+};
+
+/// Lists 0 … n − 1, list i being what `gather(i, buffer)` appends to an empty buffer, sorted
+/// ascending with duplicates removed; every entry must lie in [0, universe). `gather` runs in
+/// parallel on strata's threads (it must be safe to call concurrently for different i); the
+/// result does not depend on the thread count.
+CompressedLists sorted_unique_lists(Index n, Index universe,
+                                    const std::function<void(Index, std::vector<int>&)>& gather);
+
+/// The transpose of `lists` over `num_targets` targets: list j of the result holds, ascending,
+/// every i whose list holds j (as often as it does).
+CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets);
+
+}  // namespace strata

@@ -1,0 +1,71 @@
+#include "strata/core/common/compressed_lists.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "strata/core/common/error.hpp"
+
+namespace strata {
+
+CompressedLists sorted_unique_lists(Index n, Index universe,
+                                    const std::function<void(Index, std::vector<int>&)>& gather) {
+  STRATA_VERIFY(n >= 0 && universe >= 0, "sorted_unique_lists: negative size");
+  CompressedLists lists;
+  lists.offsets.assign(n + 1, 0);
+  if (n == 0) return lists;
+  // Fixed chunks, each collecting its lists in a buffer of its own; then one copy into place.
+  const Index num_chunks = std::min<Index>(n, 256);
+  std::vector<std::vector<int>> chunk_indices(num_chunks);
+  // Per thread, the list that last saw each entry: duplicates go before the (short) sort.
+  tbb::enumerable_thread_specific<std::vector<Index>> last_seen(
+      [&] { return std::vector<Index>(universe, -1); });
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    const Index begin = n * c / num_chunks, end = n * (c + 1) / num_chunks;
+    std::vector<Index>& seen = last_seen.local();
+    std::vector<int> buffer;
+    std::vector<int>& out = chunk_indices[c];
+    for (Index i = begin; i < end; ++i) {
+      buffer.clear();
+      gather(i, buffer);
+      const auto first = out.size();
+      for (const int entry : buffer) {
+        STRATA_VERIFY(entry >= 0 && entry < universe, "sorted_unique_lists: entry out of range");
+        if (seen[entry] == i) continue;
+        seen[entry] = i;
+        out.push_back(entry);
+      }
+      std::sort(out.begin() + first, out.end());
+      lists.offsets[i + 1] = static_cast<Index>(out.size() - first);
+    }
+  });
+  for (Index i = 0; i < n; ++i)
+    lists.offsets[i + 1] += lists.offsets[i];
+  lists.indices.resize(lists.offsets[n]);
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    const std::vector<int>& chunk = chunk_indices[c];
+    std::copy(chunk.begin(), chunk.end(),
+              lists.indices.begin() + lists.offsets[n * c / num_chunks]);
+  });
+  return lists;
+}
+
+CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets) {
+  CompressedLists result;
+  result.offsets.assign(num_targets + 1, 0);
+  for (const int j : lists.indices) {
+    STRATA_VERIFY(j >= 0 && j < num_targets, "transpose_lists: entry out of range");
+    ++result.offsets[j + 1];
+  }
+  for (Index j = 0; j < num_targets; ++j)
+    result.offsets[j + 1] += result.offsets[j];
+  result.indices.resize(lists.indices.size());
+  std::vector<Index> next(result.offsets.begin(), result.offsets.end() - 1);
+  for (Index i = 0; i < lists.size(); ++i)
+    for (const int j : lists[i])
+      result.indices[next[j]++] = static_cast<int>(i);
+  return result;
+}
+
+}  // namespace strata
