@@ -146,6 +146,9 @@ TEST(MeshAdjacency, BoundaryFacesAreTheUnmatchedFacesInSortedVertexOrder) {
   for (Index f = 0; f < faces.rows(); ++f)
     EXPECT_EQ((std::array<int, 3>{faces(f, 0), faces(f, 1), faces(f, 2)}), expected[f])
         << "face " << f;
+  MatrixX4i bad = mesh.tets;
+  bad(3, 2) = -1;
+  EXPECT_THROW(boundary_faces(bad), std::logic_error);
 }
 
 }  // namespace

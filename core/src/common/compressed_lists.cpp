@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "strata/core/common/error.hpp"
 
@@ -12,6 +13,7 @@ namespace strata {
 CompressedLists sorted_unique_lists(Index n, Index universe,
                                     const std::function<void(Index, std::vector<int>&)>& gather) {
   STRATA_VERIFY(n >= 0 && universe >= 0, "sorted_unique_lists: negative size");
+  STRATA_VERIFY(n <= std::numeric_limits<int>::max(), "sorted_unique_lists: too many lists");
   CompressedLists lists;
   lists.offsets.assign(n + 1, 0);
   if (n == 0) return lists;
@@ -19,11 +21,11 @@ CompressedLists sorted_unique_lists(Index n, Index universe,
   const Index num_chunks = std::min<Index>(n, 256);
   std::vector<std::vector<int>> chunk_indices(num_chunks);
   // Per thread, the list that last saw each entry: duplicates go before the (short) sort.
-  tbb::enumerable_thread_specific<std::vector<Index>> last_seen(
-      [&] { return std::vector<Index>(universe, -1); });
+  tbb::enumerable_thread_specific<std::vector<int>> last_seen(
+      [&] { return std::vector<int>(universe, -1); });
   tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
     const Index begin = n * c / num_chunks, end = n * (c + 1) / num_chunks;
-    std::vector<Index>& seen = last_seen.local();
+    std::vector<int>& seen = last_seen.local();
     std::vector<int> buffer;
     std::vector<int>& out = chunk_indices[c];
     for (Index i = begin; i < end; ++i) {
@@ -32,8 +34,8 @@ CompressedLists sorted_unique_lists(Index n, Index universe,
       const auto first = out.size();
       for (const int entry : buffer) {
         STRATA_VERIFY(entry >= 0 && entry < universe, "sorted_unique_lists: entry out of range");
-        if (seen[entry] == i) continue;
-        seen[entry] = i;
+        if (seen[entry] == static_cast<int>(i)) continue;
+        seen[entry] = static_cast<int>(i);
         out.push_back(entry);
       }
       std::sort(out.begin() + first, out.end());
@@ -52,6 +54,7 @@ CompressedLists sorted_unique_lists(Index n, Index universe,
 }
 
 CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets) {
+  STRATA_VERIFY(num_targets >= 0, "transpose_lists: negative number of targets");
   CompressedLists result;
   result.offsets.assign(num_targets + 1, 0);
   for (const int j : lists.indices) {

@@ -101,6 +101,7 @@ MatrixX3i boundary_faces(const MatrixX4i& tets) {
   // Outward faces of a positively oriented tet (0, 1, 2, 3).
   static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
   const Index num_faces = 4 * tets.rows();
+  STRATA_VERIFY(tets.size() == 0 || tets.minCoeff() >= 0, "boundary_faces: negative vertex index");
   const Index num_vertices = tets.size() > 0 ? Index(tets.maxCoeff()) + 1 : 0;
   // Faces bucketed by their smallest vertex (a counting sort), each bucket sorted by the other
   // two: the faces in the order of their sorted vertex triples.

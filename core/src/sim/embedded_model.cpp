@@ -140,9 +140,18 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
   double* values = K.valuePtr();
   std::fill(values, values + K.nonZeros(), 0.0);
   const double* source = m_mesh_stiffness.valuePtr();
-  for (const Term& term : m_terms)
-    for (int i = 0; i < 3; ++i)
-      values[term.target + i] += term.weight * source[term.source + i];
+  const WeightedTarget* weighted = m_weighted_targets.data();
+  for (const int target : m_block_targets) {
+    if (target >= 0) {
+      for (int i = 0; i < 3; ++i)
+        values[target + i] += source[i];
+    } else {
+      for (int n = 0; n < ~target; ++n, ++weighted)
+        for (int i = 0; i < 3; ++i)
+          values[weighted->target + i] += weighted->weight * source[i];
+    }
+    source += 3;
+  }
 }
 
 void EmbeddedElasticModel::build_reduced_pattern() {
@@ -190,51 +199,73 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     }
   });
 
-  // Terms in the order of the mesh pattern's columns (w, j), then its blocks, then C's entries.
+  // The targets of the mesh blocks, in the order of the mesh values: the columns (w, j), their
+  // blocks v, then the entries C_va, C_wb. A block whose C rows are single entries of weight 1
+  // (no hanging vertex) adds to one reduced block directly.
   const Index num_mesh_vertices = m_C.rows();
-  std::vector<Index> first_term(num_mesh_vertices + 1, 0);
+  auto direct = [&](int row) {
+    return row_outer[row + 1] - row_outer[row] == 1 && row_values[row_outer[row]] == 1.0;
+  };
+  std::vector<Index> first_weighted(num_mesh_vertices + 1, 0);
   tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+    // The three columns of a vertex hold the same blocks (the mesh pattern is 3 × 3 dense).
+    const int column_length = mesh_outer[3 * w + 1] - mesh_outer[3 * w];
+    STRATA_VERIFY(mesh_outer[3 * w + 2] - mesh_outer[3 * w + 1] == column_length &&
+                      mesh_outer[3 * w + 3] - mesh_outer[3 * w + 2] == column_length,
+                  "embedding: the mesh stiffness pattern is not made of 3 × 3 blocks");
+    const Index w_entries = row_outer[w + 1] - row_outer[w];
     Index count = 0;
     for (int k = mesh_outer[3 * w]; k < mesh_outer[3 * w + 1]; k += 3) {
       const int v = mesh_inner[k] / 3;
-      count += row_outer[v + 1] - row_outer[v];
+      if (!direct(v) || !direct(static_cast<int>(w)))
+        count += (row_outer[v + 1] - row_outer[v]) * w_entries;
     }
-    first_term[w + 1] = 3 * count * (row_outer[w + 1] - row_outer[w]);
+    first_weighted[w + 1] = 3 * count;
   });
   for (Index w = 0; w < num_mesh_vertices; ++w)
-    first_term[w + 1] += first_term[w];
+    first_weighted[w + 1] += first_weighted[w];
+  if (mesh_pattern.nonZeros() / 3 > std::numeric_limits<int>::max() ||
+      first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
+    throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
 
-  m_terms.resize(first_term[num_mesh_vertices]);
+  m_block_targets.resize(mesh_pattern.nonZeros() / 3);
+  m_weighted_targets.resize(first_weighted[num_mesh_vertices]);
   // Per thread, the slot of each block row in the list of a DOF vertex b (for w with C_w = e_b).
   tbb::enumerable_thread_specific<std::vector<int>> slots_of(
       [&] { return std::vector<int>(m_num_dof_vertices, -1); });
   tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
     const bool single = row_outer[w + 1] - row_outer[w] == 1;
+    const bool w_direct = direct(static_cast<int>(w));
     std::vector<int>& slot_of = slots_of.local();
     if (single) {
       const std::span<const int> list = blocks[row_inner[row_outer[w]]];
       for (std::size_t slot = 0; slot < list.size(); ++slot)
         slot_of[list[slot]] = static_cast<int>(slot);
     }
-    Index position = first_term[w];
+    auto target = [&](int a, int b, int j) {
+      Index slot;
+      if (single) {
+        slot = slot_of[a];
+      } else {
+        const std::span<const int> list = blocks[b];
+        slot = std::lower_bound(list.begin(), list.end(), a) - list.begin();
+      }
+      return static_cast<int>(column_start(b, j) + 3 * slot);
+    };
+    Index position = first_weighted[w];
     for (int j = 0; j < 3; ++j)
       for (int k = mesh_outer[3 * w + j]; k < mesh_outer[3 * w + j + 1]; k += 3) {
         const int v = mesh_inner[k] / 3;
-        for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia) {
-          const int a = row_inner[ia];
-          for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib) {
-            const int b = row_inner[ib];
-            Index slot;
-            if (single) {
-              slot = slot_of[a];
-            } else {
-              const std::span<const int> list = blocks[b];
-              slot = std::lower_bound(list.begin(), list.end(), a) - list.begin();
-            }
-            m_terms[position++] = {column_start(b, j) + 3 * slot, k,
-                                   row_values[ia] * row_values[ib]};
-          }
+        if (w_direct && direct(v)) {
+          m_block_targets[k / 3] = target(row_inner[row_outer[v]], row_inner[row_outer[w]], j);
+          continue;
         }
+        const Index first = position;
+        for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
+          for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
+            m_weighted_targets[position++] = {target(row_inner[ia], row_inner[ib], j),
+                                              row_values[ia] * row_values[ib]};
+        m_block_targets[k / 3] = ~static_cast<int>(position - first);
       }
   });
 }

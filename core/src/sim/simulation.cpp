@@ -16,6 +16,8 @@ namespace strata {
 
 namespace {
 
+const MatrixX3i kNoFaces;  ///< the boundary of a scene without region loads: none needed
+
 std::string format_number(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.3g", value);
@@ -66,9 +68,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   const MatrixX3d dof_rest = unflatten(m_embedded->rest_positions());
   m_groups = resolve_dirichlet_groups(dirichlet, dof_rest, tolerance);
   m_constrained = dirichlet_dof_mask(m_groups, num_dof_vertices);
-  ExternalLoads mesh_loads =
-      external_loads(m_mesh.vertices, loads.empty() ? MatrixX3i() : boundary(), m_vertex_mass,
-                     gravity, loads, tolerance);
+  ExternalLoads mesh_loads = external_loads(m_mesh.vertices, loads.empty() ? kNoFaces : boundary(),
+                                            m_vertex_mass, gravity, loads, tolerance);
   VectorXd& mesh_external = mesh_loads.base;
   if (options.extra_mesh_forces.size() > 0) {
     if (options.extra_mesh_forces.size() != mesh_external.size() ||
@@ -190,15 +191,16 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
 }
 
 const MatrixX3i& Simulation::boundary() const {
-  if (!m_boundary) m_boundary = boundary_faces(m_mesh.tets);
-  return *m_boundary;
+  std::call_once(m_boundary_once, [&] { m_boundary = boundary_faces(m_mesh.tets); });
+  return m_boundary;
 }
 
 double Simulation::stable_dt_estimate() const {
-  if (!m_stable_dt)
+  std::call_once(m_stable_dt_once, [&] {
     m_stable_dt =
         stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
-  return *m_stable_dt;
+  });
+  return m_stable_dt;
 }
 
 const ContactSettings& Simulation::contact_settings() const {

@@ -71,10 +71,10 @@ class EmbeddedElasticModel {
   const SparseMatrixd& stiffness_pattern() const;
 
  private:
-  /// One contribution to the reduced stiffness: values[target] += weight · mesh_values[source].
-  struct Term {
-    Index target;
-    Index source;
+  /// A contribution to the reduced stiffness through a hanging vertex (or any weight ≠ 1):
+  /// values[target + i] += weight · (the mesh block's value i), i = 0, 1, 2.
+  struct WeightedTarget {
+    int target;
     double weight;
   };
   void build_reduced_pattern();
@@ -89,7 +89,11 @@ class EmbeddedElasticModel {
   SparseMatrixd m_C;
   SparseMatrixd m_CT;  ///< Cᵀ, for reductions
   SparseMatrixd m_pattern;
-  std::vector<Term> m_terms;  ///< in the order of the mesh pattern's values (sources)
+  /// Per 3-value block of the mesh stiffness values (value 3g … 3g + 2), in order: the reduced
+  /// value it adds to with weight 1 (≥ 0), or ~n (< 0): it goes to the next n entries of
+  /// m_weighted_targets.
+  std::vector<int> m_block_targets;
+  std::vector<WeightedTarget> m_weighted_targets;
   mutable SparseMatrixd m_mesh_stiffness;
 };
 

@@ -22,6 +22,7 @@
 /// there), and its moment Σ (x_i − c) × R_i about the group's moment center c with the current
 /// positions as lever arms.
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -262,7 +263,8 @@ class Simulation final : public SimulationRun {
   SolverSettings m_settings;
   std::unique_ptr<ElasticModel> m_model;
   std::unique_ptr<EmbeddedElasticModel> m_embedded;
-  mutable std::optional<MatrixX3i> m_boundary;
+  mutable std::once_flag m_boundary_once;  ///< boundary() may be first called from any thread
+  mutable MatrixX3i m_boundary;
   VectorXd m_vertex_mass;
   VectorXd m_dof_vertex_mass;
   VectorXd m_dof_mass;
@@ -273,7 +275,8 @@ class Simulation final : public SimulationRun {
   std::optional<GroundPlane> m_ground;
   double m_ground_stiffness = 0.0;
   double m_diagonal = 0.0;
-  mutable std::optional<double> m_stable_dt;
+  mutable std::once_flag m_stable_dt_once;
+  mutable double m_stable_dt = 0.0;
   DivergenceLimits m_limits;
   NestedSpaces m_nested;
   std::unique_ptr<Problem> m_system;
