@@ -147,44 +147,82 @@ HangingConstraints::HangingConstraints(const TetTree& tree, const FlatTreeMesh& 
     m_free_vertices.push_back(static_cast<int>(v));
   }
 
-  // Rows of C as sparse (free index, weight) lists; parents are resolved before their children.
+  // Rows of C as sparse (free index, weight) lists, ascending in the free index: a free vertex's
+  // row is (q, 1); a hanging vertex's row (kept aside, parents resolved before their children)
+  // merges half of each parent's row.
   using Row = std::vector<std::pair<int, double>>;
-  std::vector<Row> rows(num_vertices);
-  std::vector<int> depth(num_vertices, 0);
-  for (std::size_t v = 0; v < num_vertices; ++v)
-    if (m_free_index[v] >= 0) rows[v] = {{m_free_index[v], 1.0}};
-  for (const HangingVertex& h : m_hanging) {
-    Row merged;
+  std::vector<int> hanging_slot(num_vertices, -1);
+  std::vector<Row> hanging_rows(m_hanging.size());
+  std::vector<int> depth(m_hanging.size(), 0);
+  auto parent_row = [&](int p, Row& free_row) -> const Row& {
+    if (m_free_index[p] >= 0) {
+      free_row = {{m_free_index[p], 1.0}};
+      return free_row;
+    }
+    STRATA_VERIFY(hanging_slot[p] >= 0, "HangingConstraints: parent resolved after its child");
+    return hanging_rows[hanging_slot[p]];
+  };
+  Row merged, free_row;
+  for (std::size_t k = 0; k < m_hanging.size(); ++k) {
+    const HangingVertex& h = m_hanging[k];
+    merged.clear();
+    int parent_depth = 0;
     for (const int p : h.parents) {
-      STRATA_VERIFY(!rows[p].empty(), "HangingConstraints: parent resolved after its child");
-      for (const auto& [q, w] : rows[p])
+      for (const auto& [q, w] : parent_row(p, free_row))
         merged.emplace_back(q, 0.5 * w);
+      if (hanging_slot[p] >= 0) parent_depth = std::max(parent_depth, depth[hanging_slot[p]]);
     }
     std::sort(merged.begin(), merged.end());
-    Row& row = rows[h.vertex];
+    Row& row = hanging_rows[k];
     for (const auto& [q, w] : merged) {
       if (!row.empty() && row.back().first == q)
         row.back().second += w;
       else
         row.emplace_back(q, w);
     }
-    depth[h.vertex] = 1 + std::max(depth[h.parents[0]], depth[h.parents[1]]);
-    m_max_chain_depth = std::max(m_max_chain_depth, depth[h.vertex]);
+    hanging_slot[h.vertex] = static_cast<int>(k);
+    depth[k] = 1 + parent_depth;
+    m_max_chain_depth = std::max(m_max_chain_depth, depth[k]);
   }
 
-  std::vector<Eigen::Triplet<double>> triplets;
+  // C row by row, then in its column-major storage.
+  using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+  RowMajor rows(static_cast<Index>(num_vertices), num_free());
+  std::vector<int> row_sizes(num_vertices);
   for (std::size_t v = 0; v < num_vertices; ++v)
-    for (const auto& [q, w] : rows[v])
-      triplets.emplace_back(static_cast<int>(v), q, w);
-  m_C.resize(static_cast<Index>(num_vertices), num_free());
-  m_C.setFromTriplets(triplets.begin(), triplets.end());
-  m_P = kronecker_identity3(m_C);
+    row_sizes[v] =
+        m_free_index[v] >= 0 ? 1 : static_cast<int>(hanging_rows[hanging_slot[v]].size());
+  Index nnz = 0;
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    rows.outerIndexPtr()[v] = static_cast<int>(nnz);
+    nnz += row_sizes[v];
+  }
+  rows.outerIndexPtr()[num_vertices] = static_cast<int>(nnz);
+  rows.resizeNonZeros(nnz);
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    int position = rows.outerIndexPtr()[v];
+    if (m_free_index[v] >= 0) {
+      rows.innerIndexPtr()[position] = m_free_index[v];
+      rows.valuePtr()[position] = 1.0;
+      continue;
+    }
+    for (const auto& [q, w] : hanging_rows[hanging_slot[v]]) {
+      rows.innerIndexPtr()[position] = q;
+      rows.valuePtr()[position++] = w;
+    }
+  }
+  m_C = rows;
+}
+
+SparseMatrixd HangingConstraints::dof_matrix() const {
+  return kronecker_identity3(m_C);
 }
 
 SparseMatrixd HangingConstraints::reduce_matrix(const SparseMatrixd& K) const {
   STRATA_VERIFY(K.rows() == 3 * num_vertices() && K.cols() == 3 * num_vertices(),
                 "HangingConstraints::reduce_matrix: K must be 3·#V square");
-  return SparseMatrixd(m_P.transpose() * K * m_P);
+  const SparseMatrixd P = dof_matrix();
+  return SparseMatrixd(P.transpose() * K * P);
 }
 
 VectorXd HangingConstraints::expand(ConstRef<VectorXd> q) const {

@@ -69,8 +69,8 @@ class HangingConstraints {
 
   /// Scalar C, #V × #Q, column-major.
   const SparseMatrixd& matrix() const { return m_C; }
-  /// P = C ⊗ I₃, 3·#V × 3·#Q, for the vertex-major DOF layout.
-  const SparseMatrixd& dof_matrix() const { return m_P; }
+  /// P = C ⊗ I₃, 3·#V × 3·#Q, for the vertex-major DOF layout (built on each call).
+  SparseMatrixd dof_matrix() const;
 
   /// x = C q per coordinate: 3·#Q → 3·#V (positions, velocities, displacements).
   VectorXd expand(ConstRef<VectorXd> q) const;
@@ -89,7 +89,6 @@ class HangingConstraints {
   std::vector<HangingVertex> m_hanging;
   int m_max_chain_depth = 0;
   SparseMatrixd m_C;
-  SparseMatrixd m_P;
 };
 
 /// A flattened cut with its constraints: the simulation mesh (#V vertices, flat.mesh) and x = C q.
