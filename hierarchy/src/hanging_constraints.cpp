@@ -188,14 +188,10 @@ HangingConstraints::HangingConstraints(const TetTree& tree, const FlatTreeMesh& 
   // C row by row, then in its column-major storage.
   using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
   RowMajor rows(static_cast<Index>(num_vertices), num_free());
-  std::vector<int> row_sizes(num_vertices);
-  for (std::size_t v = 0; v < num_vertices; ++v)
-    row_sizes[v] =
-        m_free_index[v] >= 0 ? 1 : static_cast<int>(hanging_rows[hanging_slot[v]].size());
   Index nnz = 0;
   for (std::size_t v = 0; v < num_vertices; ++v) {
     rows.outerIndexPtr()[v] = static_cast<int>(nnz);
-    nnz += row_sizes[v];
+    nnz += m_free_index[v] >= 0 ? 1 : static_cast<Index>(hanging_rows[hanging_slot[v]].size());
   }
   rows.outerIndexPtr()[num_vertices] = static_cast<int>(nnz);
   rows.resizeNonZeros(nnz);

@@ -87,6 +87,35 @@ TEST(CompressedLists, TransposeListsEveryMembershipOnce) {
   EXPECT_THROW(transpose_lists(lists, targets - 1), std::logic_error);
 }
 
+TEST(CompressedLists, BlockPatternHoldsEveryBlockOnceAndZeros) {
+  const Index n = 40;
+  const auto raw = random_lists(n, static_cast<int>(n), 5);
+  const CompressedLists lists = sorted_unique_lists(n, n, [&](Index i, std::vector<int>& out) {
+    out.insert(out.end(), raw[i].begin(), raw[i].end());
+  });
+  const SparseMatrixd pattern = block_pattern(lists, "test matrix");
+  // Reference: the same blocks through Eigen's triplet assembly.
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (Index b = 0; b < n; ++b)
+    for (const int a : lists[b])
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i)
+          triplets.emplace_back(3 * a + i, 3 * b + j, 1.0);
+  SparseMatrixd expected(3 * n, 3 * n);
+  expected.setFromTriplets(triplets.begin(), triplets.end());
+  ASSERT_TRUE(pattern.isCompressed());
+  ASSERT_EQ(pattern.nonZeros(), expected.nonZeros());
+  for (Index c = 0; c <= 3 * n; ++c)
+    ASSERT_EQ(pattern.outerIndexPtr()[c], expected.outerIndexPtr()[c]) << "column " << c;
+  for (Index k = 0; k < pattern.nonZeros(); ++k) {
+    ASSERT_EQ(pattern.innerIndexPtr()[k], expected.innerIndexPtr()[k]) << "entry " << k;
+    ASSERT_EQ(pattern.valuePtr()[k], 0.0);
+  }
+  for (Index b = 0; b < n; ++b)
+    for (int j = 0; j < 3; ++j)
+      EXPECT_EQ(block_column_start(lists, b, j), pattern.outerIndexPtr()[3 * b + j]);
+}
+
 // A box mesh with its vertices renumbered at random, so that adjacency is not banded.
 TetMesh shuffled_box() {
   TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(2, 1, 1.5), {5, 3, 4});

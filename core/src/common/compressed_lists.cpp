@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <string>
 
 #include "strata/core/common/error.hpp"
 
@@ -69,6 +70,29 @@ CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets)
     for (const int j : lists[i])
       result.indices[next[j]++] = static_cast<int>(i);
   return result;
+}
+
+SparseMatrixd block_pattern(const CompressedLists& block_rows, const std::string& what) {
+  const Index n = block_rows.size();
+  const Index nnz = 9 * static_cast<Index>(block_rows.indices.size());
+  if (nnz > std::numeric_limits<int>::max()) throw InputError(what + " exceeds 2^31 entries");
+  SparseMatrixd pattern(3 * n, 3 * n);
+  pattern.resizeNonZeros(nnz);
+  int* outer = pattern.outerIndexPtr();
+  int* inner = pattern.innerIndexPtr();
+  double* values = pattern.valuePtr();
+  outer[3 * n] = static_cast<int>(nnz);
+  tbb::parallel_for(Index(0), n, [&](Index b) {
+    for (int j = 0; j < 3; ++j) {
+      const Index start = block_column_start(block_rows, b, j);
+      Index position = outer[3 * b + j] = static_cast<int>(start);
+      for (const int a : block_rows[b])
+        for (int i = 0; i < 3; ++i)
+          inner[position++] = 3 * a + i;
+      std::fill(values + start, values + position, 0.0);
+    }
+  });
+  return pattern;
 }
 
 }  // namespace strata

@@ -305,27 +305,7 @@ void ElasticModel::build_stiffness_pattern() {
   const Index num_tets = m_tets.rows();
   // Column 3v + c holds, for each neighbour w of v (ascending), the rows 3w, 3w + 1, 3w + 2.
   const CompressedLists neighbours = vertex_neighbours(m_tets, m_num_vertices);
-
-  const Index nnz = 9 * static_cast<Index>(neighbours.indices.size());
-  if (nnz > std::numeric_limits<int>::max())
-    throw InputError("mesh too large: stiffness matrix exceeds 2^31 entries");
-  auto column_start = [&](Index v, int c) {
-    return static_cast<int>(9 * neighbours.offsets[v] + 3 * c * neighbours.list_size(v));
-  };
-  m_pattern.resize(num_dofs(), num_dofs());
-  m_pattern.resizeNonZeros(nnz);
-  int* outer = m_pattern.outerIndexPtr();
-  int* inner = m_pattern.innerIndexPtr();
-  outer[3 * m_num_vertices] = static_cast<int>(nnz);
-  tbb::parallel_for(Index(0), m_num_vertices, [&](Index v) {
-    for (int c = 0; c < 3; ++c) {
-      int position = outer[3 * v + c] = column_start(v, c);
-      for (const int row_vertex : neighbours[v])
-        for (int r = 0; r < 3; ++r)
-          inner[position++] = 3 * row_vertex + r;
-      std::fill(m_pattern.valuePtr() + column_start(v, c), m_pattern.valuePtr() + position, 0.0);
-    }
-  });
+  m_pattern = block_pattern(neighbours, "mesh too large: stiffness matrix");
 
   m_block_offsets.resize(48 * num_tets);
   tbb::parallel_for(Index(0), num_tets, [&](Index i) {
@@ -338,7 +318,8 @@ void ElasticModel::build_stiffness_pattern() {
           slot[a] += neighbour < tet[a];
       for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 3; ++c)
-          m_block_offsets[48 * i + 12 * a + 3 * b + c] = column_start(tet[b], c) + 3 * slot[a];
+          m_block_offsets[48 * i + 12 * a + 3 * b + c] =
+              static_cast<int>(block_column_start(neighbours, tet[b], c)) + 3 * slot[a];
     }
   });
 }

@@ -177,27 +177,7 @@ void EmbeddedElasticModel::build_reduced_pattern() {
           }
       });
 
-  const Index nnz = 9 * static_cast<Index>(blocks.indices.size());
-  if (nnz > std::numeric_limits<int>::max())
-    throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
-  // Column 3b + j holds, for each block row a of b (ascending), the rows 3a, 3a + 1, 3a + 2.
-  auto column_start = [&](Index b, int j) {
-    return 9 * blocks.offsets[b] + 3 * j * blocks.list_size(b);
-  };
-  m_pattern.resize(num_dofs(), num_dofs());
-  m_pattern.resizeNonZeros(nnz);
-  int* outer = m_pattern.outerIndexPtr();
-  int* inner = m_pattern.innerIndexPtr();
-  outer[3 * m_num_dof_vertices] = static_cast<int>(nnz);
-  tbb::parallel_for(Index(0), m_num_dof_vertices, [&](Index b) {
-    for (int j = 0; j < 3; ++j) {
-      Index position = outer[3 * b + j] = static_cast<int>(column_start(b, j));
-      for (const int a : blocks[b])
-        for (int i = 0; i < 3; ++i)
-          inner[position++] = 3 * a + i;
-      std::fill(m_pattern.valuePtr() + column_start(b, j), m_pattern.valuePtr() + position, 0.0);
-    }
-  });
+  m_pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
 
   // The targets of the mesh blocks, in the order of the mesh values: the columns (w, j), their
   // blocks v, then the entries C_va, C_wb. A block whose C rows are single entries of weight 1
@@ -250,7 +230,7 @@ void EmbeddedElasticModel::build_reduced_pattern() {
         const std::span<const int> list = blocks[b];
         slot = std::lower_bound(list.begin(), list.end(), a) - list.begin();
       }
-      return static_cast<int>(column_start(b, j) + 3 * slot);
+      return static_cast<int>(block_column_start(blocks, b, j) + 3 * slot);
     };
     Index position = first_weighted[w];
     for (int j = 0; j < 3; ++j)

@@ -4,6 +4,7 @@
 /// pattern): list i holds `indices[offsets[i] .. offsets[i + 1])`.
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -31,5 +32,16 @@ CompressedLists sorted_unique_lists(Index n, Index universe,
 /// The transpose of `lists` over `num_targets` targets: list j of the result holds, ascending,
 /// every i whose list holds j (as often as it does).
 CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets);
+
+/// The 3 × 3-block sparsity of `block_rows` (list b: the block rows of block column b,
+/// ascending) as a compressed 3n × 3n matrix of zeros: column 3b + j holds the rows 3a, 3a + 1,
+/// 3a + 2 of each a in list b. Built in parallel. Throws InputError("<what> exceeds 2^31
+/// entries") when the matrix would not fit Eigen's int indices.
+SparseMatrixd block_pattern(const CompressedLists& block_rows, const std::string& what);
+
+/// The value index of the first entry of column 3b + j in block_pattern(block_rows).
+inline Index block_column_start(const CompressedLists& block_rows, Index b, int j) {
+  return 9 * block_rows.offsets[b] + 3 * j * block_rows.list_size(b);
+}
 
 }  // namespace strata
