@@ -597,13 +597,18 @@ def summarise(args, spec):
 
 def surface_frames(folder):
     """The fine surface's .vtp frames of a run in frame order: `*_surface_NNNNNN.vtp` of a tet
-    run, else the surface frames `*_NNNNNN.vtp` of a skeleton-spring body (not its skeleton)."""
+    run, else part 0 of a skeleton-spring body's .pvd (the surface as given; part 1 is its
+    skeleton, part 2 its simplified springs' surface)."""
     if not os.path.isdir(folder):
         return []
     names = sorted(os.listdir(folder))
     frames = [f for f in names if re.fullmatch(r".*_surface_\d{6}\.vtp", f)]
     if not frames:
-        frames = [f for f in names if re.fullmatch(r".*_\d{6}\.vtp", f) and "_skeleton_" not in f]
+        for pvd in (f for f in names if f.endswith(".pvd")):
+            with open(os.path.join(folder, pvd)) as f:
+                text = f.read()
+            frames += [m.group(2) for m in re.finditer(r'part="(\d+)"\s+file="([^"]+\.vtp)"', text)
+                       if m.group(1) == "0"]
     return [os.path.join(folder, f) for f in frames]
 
 

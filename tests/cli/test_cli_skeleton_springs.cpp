@@ -68,6 +68,45 @@ TEST(CliSkeletonSprings, ACantileverComesToRestAndWritesItsOutputs) {
   EXPECT_EQ(read_vtp_points(out / "beam_000010.vtp").rows(), vertices.rows());
 }
 
+TEST(CliSkeletonSprings, ASimplifiedBodyCarriesTheFullSurface) {
+  const TempFolder folder;
+  MatrixX3d vertices;
+  write_text(folder.path() / "bar.off", bar_off(vertices));
+  ASSERT_GT(vertices.rows(), 300);
+  json scene = cantilever();
+  scene["body"]["surface_vertices"] = 200;
+  write_text(folder.path() / "beam.json", scene.dump(2));
+  const CliResult result = run_strata("run beam.json", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out, HasSubstr("(simplified from " + std::to_string(vertices.rows())));
+  const std::filesystem::path out = folder.path() / "out" / "beam";
+  const json stats = read_json(out / "stats.json");
+  EXPECT_TRUE(stats["skeleton"]["simplified"].get<bool>());
+  EXPECT_LE(stats["skeleton"]["surface_vertices"].get<int>(), 200);
+  EXPECT_EQ(stats["skeleton"]["shown_surface_vertices"], vertices.rows());
+  EXPECT_NEAR(stats["skeleton"]["mass"].get<double>(), 1.0 * 0.04, 1e-12);
+  // The clamp holds the load at rest, and the tip probe (a vertex of the full surface, carried by
+  // the simplified one) bends with the load. (Coarser springs are stiffer: the README gives the
+  // measured deflections.)
+  const std::vector<double>& last = read_csv(out / "reactions.csv").rows.back();
+  EXPECT_NEAR(last[4], 0.05, 0.05 * 0.01);
+  const Csv probes = read_csv(out / "probes.csv");
+  EXPECT_LT(probes.rows[probes.rows.size() - 2][7], 0.0);
+  // Part 0 is the full surface, part 2 the simulated one.
+  EXPECT_EQ(read_vtp_points(out / "beam_000010.vtp").rows(), vertices.rows());
+  EXPECT_LE(read_vtp_points(out / "beam_springs_000010.vtp").rows(), 200);
+  EXPECT_THAT(read_text(out / "beam.pvd"), HasSubstr("part=\"2\""));
+  // Without simplification no springs part is written.
+  scene["body"]["surface_vertices"] = 0;
+  write_text(folder.path() / "whole.json", scene.dump(2));
+  ASSERT_EQ(run_strata("run whole.json -q", folder.path()).exit_code, 0);
+  const json whole = read_json(folder.path() / "out" / "whole" / "stats.json");
+  EXPECT_FALSE(whole["skeleton"]["simplified"].get<bool>());
+  EXPECT_EQ(whole["skeleton"]["surface_vertices"], vertices.rows());
+  EXPECT_FALSE(
+      std::filesystem::exists(folder.path() / "out" / "whole" / "whole_springs_000000.vtp"));
+}
+
 TEST(CliSkeletonSprings, UnsupportedScenesGetOneLineErrors) {
   const TempFolder folder;
   MatrixX3d vertices;
@@ -100,6 +139,13 @@ TEST(CliSkeletonSprings, UnsupportedScenesGetOneLineErrors) {
   scene = cantilever();
   scene["body"] = {{"model", "tets"}, {"tie_scale", 2}};
   EXPECT_THAT(error(scene), HasSubstr("body.tie_scale: only with model \"skeleton_springs\""));
+  scene = cantilever();
+  scene["body"] = {{"model", "tets"}, {"surface_vertices", 100}};
+  EXPECT_THAT(error(scene),
+              HasSubstr("body.surface_vertices: only with model \"skeleton_springs\""));
+  scene = cantilever();
+  scene["body"]["surface_vertices"] = 3;
+  EXPECT_THAT(error(scene), HasSubstr("body.surface_vertices: expected 0"));
   scene = cantilever();
   scene["body"]["shell_ratio"] = -1;
   EXPECT_THAT(error(scene), HasSubstr("body.shell_ratio"));

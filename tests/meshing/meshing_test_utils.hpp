@@ -1,6 +1,11 @@
 #pragma once
 // Shared helpers for the meshing tests: procedural surfaces and random points.
+#include <array>
+#include <cmath>
+#include <map>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "strata/meshing/surface_mesh.hpp"
 
@@ -21,6 +26,44 @@ inline SurfaceMesh box_surface(const Vector3d& lo, const Vector3d& hi) {
       2, 6, 7, 2, 7, 3,                   // +y
       0, 2, 3, 0, 3, 1,                   // −z
       4, 5, 7, 4, 7, 6;                   // +z
+  return surface;
+}
+
+/// The unit sphere as an icosahedron whose triangles are split into four `subdivisions` times, the
+/// new vertices pushed onto the sphere: 10·4^n + 2 vertices, counter-clockwise seen from outside.
+inline SurfaceMesh sphere_surface(int subdivisions) {
+  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vector3d> points = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                  {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                  {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  for (Vector3d& p : points)
+    p.normalize();
+  std::vector<std::array<int, 3>> faces = {
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (int level = 0; level < subdivisions; ++level) {
+    std::map<std::pair<int, int>, int> midpoints;
+    const auto midpoint = [&](int a, int b) {
+      const auto [slot, inserted] =
+          midpoints.emplace(std::minmax(a, b), static_cast<int>(points.size()));
+      if (inserted) points.push_back((points[a] + points[b]).normalized());
+      return slot->second;
+    };
+    std::vector<std::array<int, 3>> finer;
+    for (const auto& [a, b, c] : faces) {
+      const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+      finer.insert(finer.end(), {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}});
+    }
+    faces = std::move(finer);
+  }
+  SurfaceMesh surface;
+  surface.vertices.resize(static_cast<Index>(points.size()), 3);
+  for (std::size_t v = 0; v < points.size(); ++v)
+    surface.vertices.row(static_cast<Index>(v)) = points[v].transpose();
+  surface.triangles.resize(static_cast<Index>(faces.size()), 3);
+  for (std::size_t f = 0; f < faces.size(); ++f)
+    surface.triangles.row(static_cast<Index>(f)) << faces[f][0], faces[f][1], faces[f][2];
   return surface;
 }
 

@@ -371,7 +371,8 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   scene.name = file.stem().string();
   if (top.has("body")) {
     const SceneValue body = top.at("body");
-    body.expect_object({"model", "shell_ratio", "surface_scale", "tie_scale", "skeleton_scale"});
+    body.expect_object({"model", "shell_ratio", "surface_scale", "tie_scale", "skeleton_scale",
+                        "surface_vertices"});
     scene.body.skeleton_springs = body.at("model").choice({"tets", "skeleton_springs"}) == 1;
     SpringBodyRule& rule = scene.body.rule;
     const std::pair<const char*, double*> factors[] = {{"shell_ratio", &rule.shell_ratio},
@@ -382,6 +383,14 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
       if (!body.has(key)) continue;
       if (!scene.body.skeleton_springs) body.at(key).fail("only with model \"skeleton_springs\"");
       *target = body.at(key).positive();
+    }
+    if (body.has("surface_vertices")) {
+      const SceneValue count = body.at("surface_vertices");
+      if (!scene.body.skeleton_springs) count.fail("only with model \"skeleton_springs\"");
+      scene.body.surface_vertices = count.integer(0);
+      if (scene.body.surface_vertices > 0 && scene.body.surface_vertices < 4)
+        count.fail("expected 0 (the surface as given) or at least 4 vertices, got " +
+                   std::to_string(scene.body.surface_vertices));
     }
     if (scene.body.skeleton_springs) {
       if (!top.at("mesh").has("surface"))

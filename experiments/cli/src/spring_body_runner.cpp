@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -18,24 +19,24 @@
 #include "strata/core/sim/stable_time_step.hpp"
 #include "strata/meshing/curve_skeleton.hpp"
 #include "strata/meshing/surface_io.hpp"
+#include "strata/meshing/surface_simplification.hpp"
+#include "strata/meshing/triangle_frame_binding.hpp"
 
 namespace strata::app::detail {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Each probe's nearest body vertex at rest; a probe farther than 5 % of the body's bounding-box
-/// diagonal from every vertex is an error naming it.
-std::vector<Index> locate_probes(const Scene& scene, const SpringBody& body) {
-  const double diagonal = (body.rest.colwise().maxCoeff() - body.rest.colwise().minCoeff()).norm();
+/// Each probe's nearest point at rest among `points` (the shown surface's vertices, then the
+/// skeleton's); a probe farther than 5 % of the body's bounding-box diagonal from every point is
+/// an error naming it.
+std::vector<Index> locate_probes(const Scene& scene, ConstRef<MatrixX3d> points) {
+  const double diagonal = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
   std::vector<Index> nearest;
   for (std::size_t p = 0; p < scene.output.probes.size(); ++p) {
     Index best = 0;
-    (body.rest.rowwise() - scene.output.probes[p].transpose())
-        .rowwise()
-        .squaredNorm()
-        .minCoeff(&best);
-    const double distance = (body.rest.row(best).transpose() - scene.output.probes[p]).norm();
+    (points.rowwise() - scene.output.probes[p].transpose()).rowwise().squaredNorm().minCoeff(&best);
+    const double distance = (points.row(best).transpose() - scene.output.probes[p]).norm();
     if (distance > 0.05 * diagonal) {
       char text[200];
       std::snprintf(text, sizeof text,
@@ -58,12 +59,25 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   RunSummary summary;
   summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
   const std::string where = scene.file.string() + ": mesh.surface";
-  SurfaceMesh surface;
+  SurfaceMesh shown;  // the surface as given, drawn and probed
   try {
-    surface = read_surface(*scene.mesh.surface);
+    shown = read_surface(*scene.mesh.surface);
   } catch (const InputError& error) {
     throw InputError(where + ": " + error.what());
   }
+  // The springs' surface: `shown` simplified (then carrying `shown` in its triangles' frames), or
+  // `shown` itself.
+  const bool simplified =
+      scene.body.surface_vertices > 0 && shown.vertices.rows() > scene.body.surface_vertices;
+  const Clock::time_point simplify_start = Clock::now();
+  const SurfaceMesh surface =
+      simplified ? simplify_surface(shown, scene.body.surface_vertices,
+                                    scene.file.string() + ": body.surface_vertices")
+                 : shown;
+  std::optional<TriangleFrameBinding> binding;
+  if (simplified) binding = bind_to_triangles(surface.vertices, surface.triangles, shown.vertices);
+  const double simplify_seconds =
+      std::chrono::duration<double>(Clock::now() - simplify_start).count();
   const CurveSkeleton skeleton = curve_skeleton(surface, where);
   std::vector<std::array<int, 2>> segments;
   for (Index e = 0; e < skeleton.edges.rows(); ++e)
@@ -74,7 +88,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
         skeleton_spring_body(surface.vertices, surface.triangles, skeleton.points, segments,
                              skeleton.owner, scene.material, scene.body.rule, "body");
     std::vector<Obstacle> obstacles =
-        build_obstacles(scene, mean_triangle_edge_length(surface.vertices, surface.triangles));
+        build_obstacles(scene, mean_triangle_edge_length(shown.vertices, shown.triangles));
     run = std::make_unique<SpringBodySimulation>(
         std::move(body), scene.material, scene.dirichlet_groups(), scene.forces, std::nullopt,
         scene.gravity, scene.solver, std::move(obstacles));
@@ -82,13 +96,36 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     throw InputError(scene.file.string() + ": " + error.what());
   }
   const SpringBody& body = run->body();
-  const std::vector<Index> probe_vertices = locate_probes(scene, body);
+  const Index S = body.num_surface;
+  const Index V = body.rest.rows();
+  const Index shown_count = shown.vertices.rows();
+  // The shown surface's vertices, then the skeleton's, at positions x (3·#V).
+  const auto shown_points = [&](const VectorXd& x) {
+    MatrixX3d points(shown_count + V - S, 3);
+    if (binding) {
+      points.topRows(shown_count) = deformed_points(*binding, body.triangles, x);
+    } else {
+      for (Index i = 0; i < S; ++i)
+        points.row(i) = x.segment<3>(3 * i).transpose();
+    }
+    for (Index k = S; k < V; ++k)
+      points.row(shown_count + k - S) = x.segment<3>(3 * k).transpose();
+    return points;
+  };
+  VectorXd rest_positions(3 * V);
+  for (Index i = 0; i < V; ++i)
+    rest_positions.segment<3>(3 * i) = body.rest.row(i).transpose();
+  const MatrixX3d shown_rest = shown_points(rest_positions);
+  const std::vector<Index> probe_points = locate_probes(scene, shown_rest);
   const long total_steps =
       static_cast<long>(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9));
   if (!options.quiet) {
     log << "strata: " << scene.file.string() << ": skeleton springs on "
-        << scene.mesh.surface->string() << ": " << body.num_surface << " surface vertices, "
-        << body.rest.rows() - body.num_surface << " skeleton points (skeletonized in "
+        << scene.mesh.surface->string() << ": " << body.num_surface << " surface vertices"
+        << (simplified ? " (simplified from " + std::to_string(shown_count) + " in " +
+                             format_duration(simplify_seconds) + ")"
+                       : std::string())
+        << ", " << body.rest.rows() - body.num_surface << " skeleton points (skeletonized in "
         << format_duration(skeleton.seconds) << "), " << body.springs.size() << " springs ("
         << body.count(SpringKind::surface) << " surface, " << body.count(SpringKind::tie)
         << " ties, " << body.count(SpringKind::skeleton) << " skeleton), mass "
@@ -111,26 +148,33 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");
   std::optional<PvdWriter> pvd;
   if (scene.output.vtk) pvd.emplace(summary.output_dir / (scene.name + ".pvd"));
-  const Index S = body.num_surface;
-  const Index V = body.rest.rows();
   double max_displacement = 0.0;
   const auto write_frame = [&]() {
     const double t = run->time();
     const VectorXd& x = run->positions();
-    MatrixX3d positions(V, 3), displacement(V, 3), velocity(V, 3);
-    for (Index i = 0; i < V; ++i) {
-      positions.row(i) = x.segment<3>(3 * i).transpose();
-      displacement.row(i) = positions.row(i) - body.rest.row(i);
-      velocity.row(i) = run->velocities().segment<3>(3 * i).transpose();
+    const VectorXd& v = run->velocities();
+    const MatrixX3d positions = shown_points(x);
+    const MatrixX3d displacement = positions - shown_rest;
+    // Velocities of the shown points: the body's own, or for a simplified body the shown
+    // positions' derivative along v by a central difference (exact but for the turning normal's
+    // second-order term).
+    MatrixX3d velocity = shown_points(v);
+    const double speed = v.cwiseAbs().maxCoeff();
+    if (binding && speed > 0.0) {
+      const double h = 1e-6 * std::max(1.0, x.cwiseAbs().maxCoeff()) / speed;
+      velocity.topRows(shown_count) =
+          (shown_points(x + h * v) - shown_points(x - h * v)).topRows(shown_count) / (2.0 * h);
+    } else if (binding) {
+      velocity.topRows(shown_count).setZero();
     }
     max_displacement = std::max(max_displacement, displacement.rowwise().norm().maxCoeff());
-    for (std::size_t p = 0; p < probe_vertices.size(); ++p) {
+    for (std::size_t p = 0; p < probe_points.size(); ++p) {
       std::ostringstream row;
       row << format_double(t) << ',' << p;
       for (int c = 0; c < 3; ++c)
         row << ',' << format_double(scene.output.probes[p][c]);
       for (int c = 0; c < 3; ++c)
-        row << ',' << format_double(displacement(probe_vertices[p], c));
+        row << ',' << format_double(displacement(probe_points[p], c));
       probes.add_row(row.str());
     }
     reactions.record(t, run->reactions());
@@ -138,10 +182,10 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
       char name[48];
       std::snprintf(name, sizeof name, "_%06d.vtp", summary.frames);
       VtuFields surface_fields;
-      surface_fields.add_point_data("displacement", displacement.topRows(S));
-      surface_fields.add_point_data("velocity", velocity.topRows(S));
-      write_vtp(summary.output_dir / (scene.name + name), positions.topRows(S), body.triangles,
-                surface_fields, scene.output.vtk_encoding);
+      surface_fields.add_point_data("displacement", displacement.topRows(shown_count));
+      surface_fields.add_point_data("velocity", velocity.topRows(shown_count));
+      write_vtp(summary.output_dir / (scene.name + name), positions.topRows(shown_count),
+                shown.triangles, surface_fields, scene.output.vtk_encoding);
       pvd->add_frame(t, scene.name + name, 0);
       std::vector<std::array<int, 2>> lines;
       for (const auto& [a, b] : body.skeleton_segments)
@@ -152,6 +196,19 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
       write_vtp_lines(summary.output_dir / (scene.name + name), positions.bottomRows(V - S), lines,
                       skeleton_fields, scene.output.vtk_encoding);
       pvd->add_frame(t, scene.name + name, 1);
+      if (simplified) {
+        MatrixX3d spring_positions(S, 3), spring_displacement(S, 3);
+        for (Index i = 0; i < S; ++i) {
+          spring_positions.row(i) = x.segment<3>(3 * i).transpose();
+          spring_displacement.row(i) = spring_positions.row(i) - body.rest.row(i);
+        }
+        VtuFields spring_fields;
+        spring_fields.add_point_data("displacement", spring_displacement);
+        std::snprintf(name, sizeof name, "_springs_%06d.vtp", summary.frames);
+        write_vtp(summary.output_dir / (scene.name + name), spring_positions, body.triangles,
+                  spring_fields, scene.output.vtk_encoding);
+        pvd->add_frame(t, scene.name + name, 2);
+      }
     }
     ++summary.frames;
   };
@@ -182,6 +239,10 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     stats["tets"] = 0;
     stats["dofs"] = 3 * V;
     stats["skeleton"] = {{"surface_vertices", S},
+                         {"shown_surface_vertices", shown_count},
+                         {"simplified", simplified},
+                         {"simplify_seconds", simplify_seconds},
+                         {"binding_max_distance", binding ? binding->distance.maxCoeff() : 0.0},
                          {"skeleton_points", V - S},
                          {"segments", body.skeleton_segments.size()},
                          {"seconds", skeleton.seconds},

@@ -62,6 +62,9 @@ struct ObstacleSpec {
 struct BodySpec {
   bool skeleton_springs = false;
   SpringBodyRule rule;
+  /// skeleton_springs: the springs live on mesh.surface simplified to at most this many vertices
+  /// (surface_simplification.hpp) and carry the full surface; 0: on mesh.surface itself.
+  Index surface_vertices = 2000;
 };
 
 /// "output".
