@@ -484,6 +484,33 @@ def draw_pictures(args, spec):
                   file=sys.stderr)
 
 
+def draw_variant_pictures(args, spec):
+    """The full run's fine surface beside each variant's surface at the last frame, coloured by
+    the displacement on one scale, into OUT/NAME/variants.png (skipped when the runs wrote no
+    surface frames)."""
+    chosen, titles = [], []
+    for name, _kind, settings in planned_runs(spec):
+        if name != "full" and not name.startswith("variant-"):
+            continue
+        frames = surface_frames(run_folder(args, spec, name, settings))
+        if frames:
+            chosen.append(frames[-1])
+            titles.append("tet model, full resolution" if name == "full"
+                          else name[len("variant-"):])
+    if len(chosen) < 2 or not chosen[0].endswith(".vtp") or titles[0] != "tet model, full resolution":
+        return
+    pictures = spec.get("pictures", {})
+    command = [sys.executable, os.path.join(HERE, "render.py"), *chosen,
+               "--out", os.path.join(args.out, spec["name"], "variants.png"),
+               "--fields", "displacement", "--exaggerate", str(pictures.get("exaggerate", 1.0)),
+               "--view", *[str(v) for v in pictures.get("view", [22.0, -60.0])],
+               "--up", pictures.get("up", "z"), "--titles", *[f"{t}, end" for t in titles]]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        print(f"experiment: rendering the variants failed: {result.stderr.strip()[-300:]}",
+              file=sys.stderr)
+
+
 def error_against(reference, frames):
     """(largest |Δu| over frames and probes / largest |u_ref|, per-time errors) or None."""
     scale = max((sum(c * c for c in u) ** 0.5 for u in reference.values()), default=0.0)
@@ -856,6 +883,7 @@ def main():
     write_results(args, spec, rows)
     if not args.report_only:
         draw_pictures(args, spec)
+        draw_variant_pictures(args, spec)
     for row in rows:
         error = "-" if row.get("error") is None else f"{100 * row['error']:.3g} %"
         estimate = row.get("estimated_error")

@@ -267,7 +267,7 @@ def main():
         os.makedirs(target, exist_ok=True)
         charts = []
         for chart in ("error_vs_cost.png", "adaptive_over_time.png", "pictures.png",
-                      "surface.png", "animation.gif"):
+                      "surface.png", "variants.png", "animation.gif"):
             source = os.path.join(args.results, name, chart)
             if os.path.exists(source):
                 shutil.copyfile(source, os.path.join(target, chart))
