@@ -693,21 +693,28 @@ def write_results(args, spec, rows):
               file=sys.stderr)
         return
     ok = [r for r in rows if r["status"] == "ok" and r.get("error") is not None]
-    figure, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for axis, cost, label in ((axes[0], "wall_seconds", "wall time [s]"),
-                              (axes[1], "max_dofs", "largest active DOFs")):
+    # Panels (cost, error measure): the probe error against wall time and against DOFs, and on
+    # scenes with a fine surface its RMS error against wall time.
+    panels = [("wall_seconds", "wall time [s]", "error", "error vs full resolution"),
+              ("max_dofs", "largest active DOFs", "error", "error vs full resolution")]
+    if any(r.get("surface_error") is not None and r["run"] != "full" for r in ok):
+        panels.append(("wall_seconds", "wall time [s]", "surface_error",
+                       "fine-surface RMS vs full resolution"))
+    figure, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4.2))
+    for axis, (cost, label, measure, measure_label) in zip(axes, panels):
+        with_measure = [r for r in ok if r.get(measure) is not None]
         for kind, style in (("uniform", "s-"), ("adaptive", "o-")):
-            points = sorted(((r[cost], max(r["error"], 1e-6), r) for r in ok if r["kind"] == kind),
-                            key=lambda p: (p[0], p[1]))
+            points = sorted(((r[cost], max(r[measure], 1e-6), r) for r in with_measure
+                             if r["kind"] == kind), key=lambda p: (p[0], p[1]))
             if points:
                 axis.plot([p[0] for p in points], [p[1] for p in points], style, label=kind)
                 for x, y, r in points:
                     axis.annotate(f"L{r['level']}" if kind == "uniform" else f"τ={r['tolerance']:g}",
                                   (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
-        for r in (r for r in ok if r["kind"] == "variant" and r.get(cost)):
-            axis.plot([r[cost]], [max(r["error"], 1e-6)], "D", label=r["variant"])
-        for r in (r for r in ok if r["kind"] == "precomputed" and r.get(cost)):
-            axis.plot([r[cost]], [max(r["error"], 1e-6)], "^", markersize=8,
+        for r in (r for r in with_measure if r["kind"] == "variant" and r.get(cost)):
+            axis.plot([r[cost]], [max(r[measure], 1e-6)], "D", label=r["variant"])
+        for r in (r for r in with_measure if r["kind"] == "precomputed" and r.get(cost)):
+            axis.plot([r[cost]], [max(r[measure], 1e-6)], "^", markersize=8,
                       label=f"precomputed, {r['windows']} window{'s' if r['windows'] > 1 else ''}")
         full = next((r for r in rows if r["run"] == "full"), None)
         if full is not None and full.get(cost):
@@ -715,7 +722,7 @@ def write_results(args, spec, rows):
         axis.set_xscale("log")
         axis.set_yscale("log")
         axis.set_xlabel(label)
-        axis.set_ylabel("error vs full resolution (below 1e-6: at 1e-6)")
+        axis.set_ylabel(f"{measure_label} (below 1e-6: at 1e-6)")
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(fontsize=8)
     figure.suptitle(f"{spec['name']}: error against cost")
