@@ -61,6 +61,7 @@ import subprocess
 import sys
 import threading
 import time
+import xml.etree.ElementTree as ElementTree
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -497,11 +498,14 @@ def draw_variant_pictures(args, spec):
             chosen.append(frames[-1])
             titles.append("tet model, full resolution" if name == "full"
                           else name[len("variant-"):])
-    if len(chosen) < 2 or not chosen[0].endswith(".vtp") or titles[0] != "tet model, full resolution":
+    picture = os.path.join(args.out, spec["name"], "variants.png")
+    if os.path.exists(picture):
+        os.remove(picture)
+    if len(chosen) < 2 or titles[0] != "tet model, full resolution":
         return
     pictures = spec.get("pictures", {})
     command = [sys.executable, os.path.join(HERE, "render.py"), *chosen,
-               "--out", os.path.join(args.out, spec["name"], "variants.png"),
+               "--out", picture,
                "--fields", "displacement", "--exaggerate", str(pictures.get("exaggerate", 1.0)),
                "--view", *[str(v) for v in pictures.get("view", [22.0, -60.0])],
                "--up", pictures.get("up", "z"), "--titles", *[f"{t}, end" for t in titles]]
@@ -632,10 +636,12 @@ def surface_frames(folder):
     frames = [f for f in names if re.fullmatch(r".*_surface_\d{6}\.vtp", f)]
     if not frames:
         for pvd in (f for f in names if f.endswith(".pvd")):
-            with open(os.path.join(folder, pvd)) as f:
-                text = f.read()
-            frames += [m.group(2) for m in re.finditer(r'part="(\d+)"\s+file="([^"]+\.vtp)"', text)
-                       if m.group(1) == "0"]
+            try:
+                root = ElementTree.parse(os.path.join(folder, pvd)).getroot()
+            except ElementTree.ParseError:
+                continue
+            frames += [d.get("file") for d in root.iter("DataSet")
+                       if d.get("part", "0") == "0" and d.get("file", "").endswith(".vtp")]
     return [os.path.join(folder, f) for f in frames]
 
 

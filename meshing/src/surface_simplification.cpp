@@ -7,6 +7,8 @@
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <CGAL/boost/graph/helpers.h>
 
+#include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -49,10 +51,17 @@ SurfaceMesh simplify_surface(const SurfaceMesh& surface, Index target_vertices,
   }
   if (!CGAL::is_closed(mesh))
     throw InputError(where + ": the surface has holes (simplification needs a closed surface)");
-  // A closed triangle surface of V vertices has 3V − 6 edges.
-  const std::size_t edges = static_cast<std::size_t>(3 * target_vertices - 6);
+  // A closed connected genus-0 surface of V vertices has 3V − 6 edges; collapses stop as soon as
+  // fewer than 3T − 5 edges are left, at T vertices.
+  const std::size_t edges = static_cast<std::size_t>(3 * target_vertices - 5);
   CGAL::Surface_mesh_simplification::Count_stop_predicate<Mesh> stop(edges);
-  CGAL::Surface_mesh_simplification::edge_collapse(mesh, stop);
+  try {
+    CGAL::Surface_mesh_simplification::edge_collapse(mesh, stop);
+  } catch (const std::bad_alloc&) {
+    throw InputError(where + ": simplification ran out of memory");
+  } catch (const std::exception& error) {
+    throw InputError(where + ": simplification failed: " + error.what());
+  }
   mesh.collect_garbage();
 
   SurfaceMesh result;

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -12,19 +13,60 @@
 namespace strata {
 namespace {
 
-/// The frame (x1 − x0, x2 − x0, n̂) of a triangle as matrix columns.
-Matrix3d triangle_frame(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2) {
-  Matrix3d frame;
-  frame.col(0) = x1 - x0;
-  frame.col(1) = x2 - x0;
-  frame.col(2) = frame.col(0).cross(frame.col(1)).normalized();
-  return frame;
-}
-
 bool degenerate(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2) {
   const double longest =
       std::max({(x1 - x0).squaredNorm(), (x2 - x1).squaredNorm(), (x0 - x2).squaredNorm()});
   return !((x1 - x0).cross(x2 - x0).norm() > 1e-14 * longest);
+}
+
+/// A triangle's orthonormal frame (t, n̂ × t, n̂) as columns and, given its corners' velocities,
+/// the frame's time derivative. t follows edge `edge` (x_k → x_{k+1} for k = edge).
+struct Frame {
+  Matrix3d R;
+  Matrix3d dR = Matrix3d::Zero();
+};
+
+/// d/dt of a / |a| for ȧ: (I − â âᵀ) ȧ / |a|; zero for a = 0.
+Vector3d unit_rate(const Vector3d& a, const Vector3d& a_dot) {
+  const double length = a.norm();
+  if (!(length > 0.0)) return Vector3d::Zero();
+  const Vector3d unit = a / length;
+  return (a_dot - unit * unit.dot(a_dot)) / length;
+}
+
+Frame triangle_frame(const Vector3d* x, int edge, const Vector3d* v = nullptr) {
+  const Vector3d e = x[(edge + 1) % 3] - x[edge];
+  const Vector3d a = x[1] - x[0], b = x[2] - x[0];
+  const Vector3d normal_vector = a.cross(b);
+  Frame frame;
+  const Vector3d t = e.normalized();  // Eigen leaves a zero vector unchanged
+  const Vector3d n = normal_vector.normalized();
+  frame.R.col(0) = t;
+  frame.R.col(1) = n.cross(t);
+  frame.R.col(2) = n;
+  if (v != nullptr) {
+    const Vector3d t_dot = unit_rate(e, v[(edge + 1) % 3] - v[edge]);
+    const Vector3d n_dot = unit_rate(normal_vector, (v[1] - v[0]).cross(b) + a.cross(v[2] - v[0]));
+    frame.dR.col(0) = t_dot;
+    frame.dR.col(1) = n_dot.cross(t) + n.cross(t_dot);
+    frame.dR.col(2) = n_dot;
+  }
+  return frame;
+}
+
+/// The edge of the rest triangle the frame's first axis follows: its longest.
+int longest_edge(const Vector3d* x) {
+  int best = 0;
+  for (int k = 1; k < 3; ++k)
+    if ((x[(k + 1) % 3] - x[k]).squaredNorm() > (x[(best + 1) % 3] - x[best]).squaredNorm())
+      best = k;
+  return best;
+}
+
+template <typename Points>
+void corners(const Points& points, ConstRef<MatrixX3i> triangles, int f, Vector3d* x) {
+  for (int k = 0; k < 3; ++k)
+    x[k] = points(triangles(f, k));
 }
 
 }  // namespace
@@ -58,39 +100,77 @@ TriangleFrameBinding bind_to_triangles(ConstRef<MatrixX3d> coarse_vertices,
   const Index N = fine_vertices.rows();
   TriangleFrameBinding binding;
   binding.triangles.resize(N);
-  binding.coefficients.resize(N, 3);
+  binding.edges.resize(N);
+  binding.barycentric.resize(N, 3);
+  binding.offset.resize(N, 3);
   binding.distance.resize(N);
+  const auto rest = [&](Index v) -> Vector3d { return coarse_vertices.row(v).transpose(); };
   tbb::parallel_for(tbb::blocked_range<Index>(0, N, 256), [&](const tbb::blocked_range<Index>& r) {
     for (Index i = r.begin(); i != r.end(); ++i) {
       const Vector3d X = fine_vertices.row(i).transpose();
       const SurfaceClosestPoint nearest = bvh.closest_point(X);
       const int f = kept[nearest.triangle];
-      const Vector3d x0 = coarse_vertices.row(coarse_triangles(f, 0)).transpose();
-      const Matrix3d frame =
-          triangle_frame(x0, coarse_vertices.row(coarse_triangles(f, 1)).transpose(),
-                         coarse_vertices.row(coarse_triangles(f, 2)).transpose());
+      Vector3d x[3];
+      corners(rest, coarse_triangles, f, x);
+      const int edge = longest_edge(x);
+      const Frame frame = triangle_frame(x, edge);
+      const Vector3d p = nearest.barycentric[0] * x[0] + nearest.barycentric[1] * x[1] +
+                         nearest.barycentric[2] * x[2];
       binding.triangles[i] = f;
-      binding.coefficients.row(i) = frame.partialPivLu().solve(X - x0).transpose();
+      binding.edges[i] = edge;
+      binding.barycentric.row(i) = nearest.barycentric.transpose();
+      binding.offset.row(i) = (frame.R.transpose() * (X - p)).transpose();
       binding.distance[i] = nearest.distance;
     }
   });
   return binding;
 }
 
+namespace {
+
+template <typename Each>
+void for_each_bound(const TriangleFrameBinding& binding, Each&& each) {
+  const Index N = binding.triangles.size();
+  tbb::parallel_for(tbb::blocked_range<Index>(0, N, 1024), [&](const tbb::blocked_range<Index>& r) {
+    for (Index i = r.begin(); i != r.end(); ++i)
+      each(i);
+  });
+}
+
+}  // namespace
+
 MatrixX3d deformed_points(const TriangleFrameBinding& binding, ConstRef<MatrixX3i> coarse_triangles,
                           ConstRef<VectorXd> positions) {
-  const Index N = binding.triangles.size();
-  MatrixX3d points(N, 3);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, N, 1024), [&](const tbb::blocked_range<Index>& r) {
-    for (Index i = r.begin(); i != r.end(); ++i) {
-      const int f = binding.triangles[i];
-      const Vector3d x0 = positions.segment<3>(3 * coarse_triangles(f, 0));
-      const Matrix3d frame = triangle_frame(x0, positions.segment<3>(3 * coarse_triangles(f, 1)),
-                                            positions.segment<3>(3 * coarse_triangles(f, 2)));
-      points.row(i) = (x0 + frame * binding.coefficients.row(i).transpose()).transpose();
-    }
+  MatrixX3d points(binding.triangles.size(), 3);
+  const auto at = [&](Index v) -> Vector3d { return positions.segment<3>(3 * v); };
+  for_each_bound(binding, [&](Index i) {
+    Vector3d x[3];
+    corners(at, coarse_triangles, binding.triangles[i], x);
+    const Frame frame = triangle_frame(x, binding.edges[i]);
+    points.row(i) = (binding.barycentric(i, 0) * x[0] + binding.barycentric(i, 1) * x[1] +
+                     binding.barycentric(i, 2) * x[2] + frame.R * binding.offset.row(i).transpose())
+                        .transpose();
   });
   return points;
+}
+
+MatrixX3d deformed_velocities(const TriangleFrameBinding& binding,
+                              ConstRef<MatrixX3i> coarse_triangles, ConstRef<VectorXd> positions,
+                              ConstRef<VectorXd> velocities) {
+  MatrixX3d result(binding.triangles.size(), 3);
+  const auto at = [&](Index v) -> Vector3d { return positions.segment<3>(3 * v); };
+  const auto rate = [&](Index v) -> Vector3d { return velocities.segment<3>(3 * v); };
+  for_each_bound(binding, [&](Index i) {
+    Vector3d x[3], v[3];
+    corners(at, coarse_triangles, binding.triangles[i], x);
+    corners(rate, coarse_triangles, binding.triangles[i], v);
+    const Frame frame = triangle_frame(x, binding.edges[i], v);
+    result.row(i) =
+        (binding.barycentric(i, 0) * v[0] + binding.barycentric(i, 1) * v[1] +
+         binding.barycentric(i, 2) * v[2] + frame.dR * binding.offset.row(i).transpose())
+            .transpose();
+  });
+  return result;
 }
 
 }  // namespace strata

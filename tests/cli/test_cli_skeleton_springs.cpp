@@ -92,8 +92,16 @@ TEST(CliSkeletonSprings, ASimplifiedBodyCarriesTheFullSurface) {
   EXPECT_NEAR(last[4], 0.05, 0.05 * 0.01);
   const Csv probes = read_csv(out / "probes.csv");
   EXPECT_LT(probes.rows[probes.rows.size() - 2][7], 0.0);
-  // Part 0 is the full surface, part 2 the simulated one.
-  EXPECT_EQ(read_vtp_points(out / "beam_000010.vtp").rows(), vertices.rows());
+  // Part 0 is the full surface (its points the rest ones plus the displacement, the tip probe's
+  // displacement that of its nearest vertex), part 2 the simulated one.
+  const VtkFrame last_frame = read_vtk_frame(out / "beam_000010.vtp");
+  ASSERT_EQ(last_frame.points.rows(), vertices.rows());
+  const Eigen::MatrixXd& shown_displacement = last_frame.point_field("displacement");
+  EXPECT_LT((last_frame.points - vertices - shown_displacement).cwiseAbs().maxCoeff(), 1e-12);
+  Index tip = 0;
+  (vertices.rowwise() - Eigen::RowVector3d(1, 0.1, 0.1)).rowwise().squaredNorm().minCoeff(&tip);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(probes.rows[probes.rows.size() - 2][5 + c], shown_displacement(tip, c), 1e-12);
   EXPECT_LE(read_vtp_points(out / "beam_springs_000010.vtp").rows(), 200);
   EXPECT_THAT(read_text(out / "beam.pvd"), HasSubstr("part=\"2\""));
   // Without simplification no springs part is written.

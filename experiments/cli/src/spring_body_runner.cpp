@@ -71,11 +71,15 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
       scene.body.surface_vertices > 0 && shown.vertices.rows() > scene.body.surface_vertices;
   const Clock::time_point simplify_start = Clock::now();
   const SurfaceMesh surface =
-      simplified ? simplify_surface(shown, scene.body.surface_vertices,
-                                    scene.file.string() + ": body.surface_vertices")
-                 : shown;
+      simplified ? simplify_surface(shown, scene.body.surface_vertices, where) : shown;
   std::optional<TriangleFrameBinding> binding;
-  if (simplified) binding = bind_to_triangles(surface.vertices, surface.triangles, shown.vertices);
+  if (simplified) {
+    try {
+      binding = bind_to_triangles(surface.vertices, surface.triangles, shown.vertices);
+    } catch (const InputError& error) {
+      throw InputError(where + ": binding to the simplified surface: " + error.what());
+    }
+  }
   const double simplify_seconds =
       std::chrono::duration<double>(Clock::now() - simplify_start).count();
   const CurveSkeleton skeleton = curve_skeleton(surface, where);
@@ -155,18 +159,15 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     const VectorXd& v = run->velocities();
     const MatrixX3d positions = shown_points(x);
     const MatrixX3d displacement = positions - shown_rest;
-    // Velocities of the shown points: the body's own, or for a simplified body the shown
-    // positions' derivative along v by a central difference (exact but for the turning normal's
-    // second-order term).
-    MatrixX3d velocity = shown_points(v);
-    const double speed = v.cwiseAbs().maxCoeff();
-    if (binding && speed > 0.0) {
-      const double h = 1e-6 * std::max(1.0, x.cwiseAbs().maxCoeff()) / speed;
-      velocity.topRows(shown_count) =
-          (shown_points(x + h * v) - shown_points(x - h * v)).topRows(shown_count) / (2.0 * h);
-    } else if (binding) {
-      velocity.topRows(shown_count).setZero();
+    MatrixX3d velocity(positions.rows(), 3);
+    if (binding) {
+      velocity.topRows(shown_count) = deformed_velocities(*binding, body.triangles, x, v);
+    } else {
+      for (Index i = 0; i < S; ++i)
+        velocity.row(i) = v.segment<3>(3 * i).transpose();
     }
+    for (Index k = S; k < V; ++k)
+      velocity.row(shown_count + k - S) = v.segment<3>(3 * k).transpose();
     max_displacement = std::max(max_displacement, displacement.rowwise().norm().maxCoeff());
     for (std::size_t p = 0; p < probe_points.size(); ++p) {
       std::ostringstream row;
@@ -187,6 +188,9 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
       write_vtp(summary.output_dir / (scene.name + name), positions.topRows(shown_count),
                 shown.triangles, surface_fields, scene.output.vtk_encoding);
       pvd->add_frame(t, scene.name + name, 0);
+    }
+    if (pvd && scene.output.vtk_mesh) {
+      char name[48];
       std::vector<std::array<int, 2>> lines;
       for (const auto& [a, b] : body.skeleton_segments)
         lines.push_back({static_cast<int>(a - S), static_cast<int>(b - S)});

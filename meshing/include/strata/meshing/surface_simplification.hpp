@@ -10,10 +10,11 @@
 
 namespace strata {
 
-/// The surface collapsed to at most `target_vertices` vertices (about; CGAL stops on the edge
-/// count 3·target − 6 of a closed surface), orientation kept, vertices renumbered densely. A
-/// surface already at or below the target is returned unchanged. Throws InputError naming `where`
-/// for a target below 4 or a surface that is not a closed 2-manifold.
+/// The surface collapsed to `target_vertices` vertices (CGAL stops on the edge count: exactly the
+/// target for a connected genus-0 surface, about it for others), orientation kept, vertices
+/// renumbered densely. A surface already at or below the target is returned unchanged. Throws
+/// InputError naming `where` for a target below 4, a surface that is not a closed 2-manifold, or a
+/// failed collapse.
 SurfaceMesh simplify_surface(const SurfaceMesh& surface, Index target_vertices,
                              const std::string& where);
 
