@@ -3,21 +3,15 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
 #include <string>
 #include <vector>
 
 #include "strata/core/common/error.hpp"
+#include "strata/meshing/surface_mesh.hpp"
 #include "strata/meshing/triangle_bvh.hpp"
 
 namespace strata {
 namespace {
-
-bool degenerate(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2) {
-  const double longest =
-      std::max({(x1 - x0).squaredNorm(), (x2 - x1).squaredNorm(), (x0 - x2).squaredNorm()});
-  return !((x1 - x0).cross(x2 - x0).norm() > 1e-14 * longest);
-}
 
 /// A triangle's orthonormal frame (t, n̂ × t, n̂) as columns and, given its corners' velocities,
 /// the frame's time derivative. t follows edge `edge` (x_k → x_{k+1} for k = edge).
@@ -75,19 +69,17 @@ TriangleFrameBinding bind_to_triangles(ConstRef<MatrixX3d> coarse_vertices,
                                        ConstRef<MatrixX3i> coarse_triangles,
                                        ConstRef<MatrixX3d> fine_vertices) {
   const Index V = coarse_vertices.rows();
-  std::vector<int> kept;
-  for (Index f = 0; f < coarse_triangles.rows(); ++f) {
+  for (Index f = 0; f < coarse_triangles.rows(); ++f)
     for (int c = 0; c < 3; ++c) {
       const int v = coarse_triangles(f, c);
       if (v < 0 || v >= V)
         throw InputError("coarse triangle " + std::to_string(f) + " names vertex " +
                          std::to_string(v) + " of " + std::to_string(V));
     }
-    if (!degenerate(coarse_vertices.row(coarse_triangles(f, 0)).transpose(),
-                    coarse_vertices.row(coarse_triangles(f, 1)).transpose(),
-                    coarse_vertices.row(coarse_triangles(f, 2)).transpose()))
-      kept.push_back(static_cast<int>(f));
-  }
+  const SurfaceMesh coarse{coarse_vertices, coarse_triangles};
+  std::vector<int> kept;
+  for (Index f = 0; f < coarse_triangles.rows(); ++f)
+    if (!is_degenerate_triangle(coarse, f)) kept.push_back(static_cast<int>(f));
   if (kept.empty()) throw InputError("the coarse surface has no triangle of positive area");
   MatrixX3i kept_triangles(static_cast<Index>(kept.size()), 3);
   for (std::size_t k = 0; k < kept.size(); ++k)
