@@ -109,6 +109,8 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
   refinement_indicator_traits(settings.indicator, where + ".indicator");
   if (!(settings.tolerance > 0.0 && settings.tolerance < 1.0))
     throw InputError(where + ".tolerance: must be in (0, 1)");
+  if (!(settings.full_resolution_fraction > 0.0 && settings.full_resolution_fraction <= 1.0))
+    throw InputError(where + ".full_resolution_fraction: must be in (0, 1]");
   validate_refinement_settings(settings.criteria, where);
   if (settings.mode == HierarchyMode::precomputed && !settings.precomputed)
     throw InputError(where + ".cut: mode \"precomputed\" needs a precomputed cut");
@@ -271,6 +273,13 @@ void AdaptiveSimulation::initial_adaptation() {
     changes.coarsen.clear();
     m_report.refused_refinements += changes.refused;
     if (changes.refine.empty()) break;
+    if (exceeds_full_resolution_fraction(changes)) {
+      m_report.initial_refinements += static_cast<int>(edit_to_full_resolution().refined);
+      m_report.full_resolution_step = 0;
+      m_at_full_resolution = true;
+      changed = true;
+      break;
+    }
     if (m_obstacles.empty()) {
       previous_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
       previous_positions = solve->positions();
@@ -396,8 +405,7 @@ void AdaptiveSimulation::rebuild(long first_step) {
 
 void AdaptiveSimulation::advance() {
   if (m_failed) throw std::logic_error("AdaptiveSimulation::advance: a previous cut change failed");
-  if (m_settings.mode == HierarchyMode::adaptive && !is_static(m_solver) &&
-      m_settings.in_step_refinement) {
+  if (adapting() && !is_static(m_solver) && m_settings.in_step_refinement) {
     advance_with_redo();
     record_sample();
     return;
@@ -413,17 +421,18 @@ void AdaptiveSimulation::advance() {
   m_estimate_valid = false;
   m_simulation->advance();
   m_stepping_seconds += seconds_since(start);
-  if (m_settings.mode == HierarchyMode::adaptive && is_static(m_solver)) {
+  if (adapting() && is_static(m_solver)) {
     // Solve–mark–refine: re-solve the same load factor on each new cut.
-    for (int pass = 0; pass < m_settings.max_passes && adapt(pass, true, true); ++pass) {
+    for (int pass = 0; pass < m_settings.max_passes && adapting() && adapt(pass, true, true);
+         ++pass) {
       const auto solve_start = Clock::now();
       m_simulation->resolve_static();
       m_stepping_seconds += seconds_since(solve_start);
     }
   }
   record_contact_step();
-  if (m_settings.mode == HierarchyMode::adaptive && !is_static(m_solver) &&
-      step_count() % m_settings.adapt_every == 0 && !finished())
+  if (adapting() && !is_static(m_solver) && step_count() % m_settings.adapt_every == 0 &&
+      !finished())
     adapt(0, true, true);
   record_sample();
 }
@@ -440,7 +449,7 @@ void AdaptiveSimulation::advance_with_redo() {
   m_simulation->advance();
   double attempt = seconds_since(step_start);
   m_stepping_seconds += attempt;
-  for (int pass = 0; pass < m_settings.max_passes; ++pass) {
+  for (int pass = 0; pass < m_settings.max_passes && adapting(); ++pass) {
     const CutChanges changes = decide(true, false);
     if (changes.refine.empty()) break;
     ++m_report.redone_steps;
@@ -460,7 +469,8 @@ void AdaptiveSimulation::advance_with_redo() {
     m_stepping_seconds += attempt;
   }
   record_contact_step();
-  if (step_count() % m_settings.adapt_every == 0 && !finished()) adapt(0, false, true);
+  if (adapting() && step_count() % m_settings.adapt_every == 0 && !finished())
+    adapt(0, false, true);
 }
 
 void AdaptiveSimulation::add_contact(SimulationOptions& options) const {
@@ -550,7 +560,14 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.momentum_before = old_momentum;
   const VectorXd old_positions = x_mesh;
   const VectorXd old_velocities = v_mesh;
-  const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
+  const bool to_full_resolution = exceeds_full_resolution_fraction(changes);
+  const CutChangeCounts counts = to_full_resolution
+                                     ? edit_to_full_resolution()
+                                     : m_controller->apply(*m_cut, changes, sim.step_count());
+  if (to_full_resolution) {
+    m_at_full_resolution = true;
+    m_report.full_resolution_step = first_step;
+  }
   record.refined = counts.refined + counts.balance_refined;
   record.coarsened = counts.coarsened;
 
@@ -596,6 +613,36 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.seconds = seconds_since(start);
   m_bookkeeping_seconds += record.seconds;
   m_changes.push_back(record);
+}
+
+bool AdaptiveSimulation::adapting() const {
+  return m_settings.mode == HierarchyMode::adaptive && !m_at_full_resolution;
+}
+
+bool AdaptiveSimulation::exceeds_full_resolution_fraction(const CutChanges& changes) const {
+  if (m_settings.mode != HierarchyMode::adaptive || m_settings.full_resolution_fraction >= 1.0 ||
+      changes.refine.empty() || is_explicit(m_solver) || max_refine_level() < m_tree->max_level())
+    return false;
+  const double finest = static_cast<double>(m_tree->num_roots()) *
+                        std::pow(8.0, static_cast<double>(m_tree->max_level()));
+  const Index budget = m_settings.criteria.max_active_elements;
+  if (budget > 0 && static_cast<double>(budget) < finest) return false;
+  // A refinement replaces one tet by eight; a merge, eight by one.
+  const double after = static_cast<double>(m_cut->size()) +
+                       7.0 * static_cast<double>(changes.refine.size()) -
+                       7.0 * static_cast<double>(changes.coarsen.size());
+  return after > m_settings.full_resolution_fraction * finest;
+}
+
+CutChangeCounts AdaptiveSimulation::edit_to_full_resolution() {
+  CutChangeCounts counts;
+  for (int level = m_cut->coarsest_level(); level < m_tree->max_level(); ++level)
+    for (NodeId n : std::vector<NodeId>(m_cut->nodes()))
+      if (m_tree->level(n) == level) {
+        m_cut->refine(n);
+        ++counts.refined;
+      }
+  return counts;
 }
 
 int AdaptiveSimulation::max_refine_level() const {
@@ -693,7 +740,8 @@ void AdaptiveSimulation::record_sample() {
   sample.tets = m_cut->size();
   sample.dofs = m_simulation->embedded_model().num_dofs();
   sample.hanging = m_constrained->constraints.num_hanging();
-  if (m_settings.mode != HierarchyMode::full) {  // full resolution: zero by definition
+  if (m_settings.mode != HierarchyMode::full &&
+      !m_at_full_resolution) {  // full resolution: zero by definition
     const RecoveryEstimate estimate = estimate_error();
     sample.estimated_error = estimate.relative_error;
     sample.estimated_energy_error = estimate.relative_energy_error;

@@ -210,5 +210,42 @@ TEST(CliHierarchy, BadToleranceNamesTheKey) {
   EXPECT_THAT(bad.err, HasSubstr("hierarchy.tolerance"));
 }
 
+TEST(CliHierarchy, ACutPastTheFullResolutionFractionGoesOnAtFullResolution) {
+  const TempFolder folder;
+  const SlabRun full = run_slab(folder, "full");
+  json scene = slab_scene("adaptive");
+  scene["hierarchy"] = {{"levels", 2}, {"full_resolution_fraction", 0.05}};
+  write_text(folder.path() / "switch.json", scene.dump(2));
+  const CliResult result = run_strata("run switch.json", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.out + result.err, HasSubstr("the run went on at full resolution"));
+  const std::filesystem::path out = folder.path() / "out" / "switch";
+  const json stats = read_json(out / "stats.json");
+  const json& h = stats["hierarchy"];
+  EXPECT_EQ(h["mode"], "adaptive");
+  EXPECT_EQ(h["full_resolution_fraction"], 0.05);
+  EXPECT_EQ(h["full_resolution_step"], 1);  // after the first load step's first solve
+  EXPECT_EQ(stats["tets"].get<double>(), 96.0 * 64.0);
+  const Csv probes = read_csv(out / "probes.csv");
+  ASSERT_EQ(probes.rows.size(), 6u);
+  EXPECT_NEAR(probes.rows[4][7], full.probe_uz, 1e-9 * std::abs(full.probe_uz));
+
+  // The default fraction leaves this cut adaptive.
+  scene["hierarchy"] = {{"levels", 2}, {"tolerance", 0.3}};
+  write_text(folder.path() / "loose.json", scene.dump(2));
+  ASSERT_EQ(run_strata("run loose.json --quiet", folder.path()).exit_code, 0);
+  const json loose = read_json(folder.path() / "out" / "loose" / "stats.json");
+  EXPECT_TRUE(loose["hierarchy"]["full_resolution_step"].is_null());
+  EXPECT_LT(loose["tets"].get<double>(), 96.0 * 64.0);
+
+  for (double fraction : {0.0, 1.5}) {
+    scene["hierarchy"] = {{"levels", 2}, {"full_resolution_fraction", fraction}};
+    write_text(folder.path() / "bad.json", scene.dump(2));
+    const CliResult bad = run_strata("run bad.json --quiet", folder.path());
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_THAT(bad.err, HasSubstr("hierarchy.full_resolution_fraction"));
+  }
+}
+
 }  // namespace
 }  // namespace strata::cli_test

@@ -32,12 +32,14 @@ Obstacle sphere_obstacle(const Vector3d& center, double radius) {
   return obstacle;
 }
 
-/// Error-controlled adaptive settings (recovery estimate, in-step refinement) at `tolerance`.
+/// Error-controlled adaptive settings (recovery estimate, in-step refinement) at `tolerance`; the
+/// cut adapts however large it grows (no switch to full resolution), as these tests follow it.
 HierarchySettings error_controlled(int levels, double tolerance) {
   HierarchySettings settings;
   settings.levels = levels;
   settings.mode = HierarchyMode::adaptive;
   settings.tolerance = tolerance;
+  settings.full_resolution_fraction = 1.0;
   return settings;
 }
 

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "adaptive_test_utils.hpp"
+#include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
 
@@ -53,13 +55,15 @@ struct PokedPlate {
     return frames;
   }
   std::vector<MatrixX3d> run(const HierarchySettings& h, ToleranceReport* report = nullptr,
-                             Index* initial_tets = nullptr, long* steps = nullptr) const {
+                             Index* initial_tets = nullptr, long* steps = nullptr,
+                             Index* final_tets = nullptr) const {
     AdaptiveSimulation sim(coarse, h, material(), fixed, loads, std::nullopt, Vector3d::Zero(),
                            solver());
     if (initial_tets) *initial_tets = sim.cut().size();
     std::vector<MatrixX3d> frames = run(sim);
     if (report) *report = sim.tolerance_report();
     if (steps) *steps = sim.counters().steps;
+    if (final_tets) *final_tets = sim.cut().size();
     return frames;
   }
 };
@@ -149,6 +153,69 @@ TEST(AdaptiveTolerance, AToleranceTheCutCannotMeetIsReported) {
   EXPECT_GT(report.steps_over_tolerance, 0);
   EXPECT_GT(report.max_estimated_error, h.tolerance);
   EXPECT_GT(report.refused_refinements, 0);
+}
+
+TEST(AdaptiveTolerance, ACutPastTheFullResolutionFractionGoesOnAtFullResolution) {
+  const PokedPlate plate;
+  const std::vector<MatrixX3d> full = full_run(plate);
+  const Index finest = plate.coarse.tets.rows() * 64;
+  // Any refinement takes this cut past the fraction: the initial adaptation's first pass ends it.
+  HierarchySettings h = defaults(2);
+  h.full_resolution_fraction = 0.02;
+  ToleranceReport report;
+  Index initial_tets = 0, final_tets = 0;
+  const std::vector<MatrixX3d> early = plate.run(h, &report, &initial_tets, nullptr, &final_tets);
+  EXPECT_EQ(report.full_resolution_step, 0);
+  EXPECT_EQ(report.initial_passes, 1);
+  EXPECT_EQ(initial_tets, finest);
+  EXPECT_EQ(final_tets, finest);
+  EXPECT_EQ(report.redone_steps, 0);
+  EXPECT_EQ(report.max_estimated_error, 0.0);
+  // The same cut as full resolution, flattened in another order: the same run up to round-off.
+  EXPECT_LE(run_error(early, full), 1e-9);
+
+  // Without the initial adaptation the first step is redone at full resolution from rest.
+  h.initial_adaptation = false;
+  long steps = 0;
+  const std::vector<MatrixX3d> redone = plate.run(h, &report, &initial_tets, &steps, &final_tets);
+  EXPECT_EQ(initial_tets, plate.coarse.tets.rows());
+  EXPECT_EQ(report.full_resolution_step, 0);
+  EXPECT_EQ(report.redone_steps, 1);
+  EXPECT_EQ(steps, static_cast<long>(redone.size()));
+  EXPECT_EQ(final_tets, finest);
+  EXPECT_LE(run_error(redone, full), 1e-9);
+}
+
+TEST(AdaptiveTolerance, AFractionOfOneNeverGoesToFullResolution) {
+  const PokedPlate plate;
+  HierarchySettings h = defaults(2);
+  h.tolerance = 0.005;
+  h.full_resolution_fraction = 1.0;
+  ToleranceReport report;
+  Index final_tets = 0;
+  plate.run(h, &report, nullptr, nullptr, &final_tets);
+  EXPECT_EQ(report.full_resolution_step, -1);
+  EXPECT_GT(report.initial_passes, 1);
+  // At the default fraction the same tolerance goes to full resolution.
+  h.full_resolution_fraction = HierarchySettings{}.full_resolution_fraction;
+  plate.run(h, &report, nullptr, nullptr, &final_tets);
+  EXPECT_GE(report.full_resolution_step, 0);
+  EXPECT_EQ(final_tets, plate.coarse.tets.rows() * 64);
+}
+
+TEST(AdaptiveTolerance, FullResolutionFractionOutsideItsRangeIsRefused) {
+  for (double fraction : {0.0, -0.5, 1.5}) {
+    HierarchySettings h = defaults(2);
+    h.full_resolution_fraction = fraction;
+    try {
+      validate_hierarchy_settings(h, "hierarchy");
+      ADD_FAILURE() << "accepted " << fraction;
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("hierarchy.full_resolution_fraction"),
+                std::string::npos)
+          << error.what();
+    }
+  }
 }
 
 }  // namespace

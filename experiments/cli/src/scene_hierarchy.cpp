@@ -13,7 +13,7 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
                        "refine_threshold", "coarsen_tolerance", "coarsen_indicator_fraction",
                        "stress_floor", "min_steps_between_changes", "max_active_elements",
                        "max_level", "balance", "tolerance", "initial_adaptation",
-                       "in_step_refinement", "cut"});
+                       "in_step_refinement", "full_resolution_fraction", "cut"});
   HierarchySettings settings;
   settings.levels = value.at("levels").integer(0);
   if (settings.levels > 8) value.at("levels").fail("must be at most 8");
@@ -51,6 +51,11 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
     settings.initial_adaptation = value.at("initial_adaptation").boolean();
   if (value.has("in_step_refinement"))
     settings.in_step_refinement = value.at("in_step_refinement").boolean();
+  if (value.has("full_resolution_fraction")) {
+    settings.full_resolution_fraction = value.at("full_resolution_fraction").positive();
+    if (settings.full_resolution_fraction > 1.0)
+      value.at("full_resolution_fraction").fail("must be in (0, 1]");
+  }
   RefinementSettings& criteria = settings.criteria;
   if (value.has("refine_threshold")) {
     criteria.refine_threshold = value.at("refine_threshold").positive();

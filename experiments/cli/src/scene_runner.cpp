@@ -214,6 +214,12 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
   block["initial_passes"] = report.initial_passes;
   block["initial_newton_iterations"] = report.initial_newton_iterations;
   block["initial_adaptation_seconds"] = report.initial_adaptation_seconds;
+  block["full_resolution_fraction"] = settings.full_resolution_fraction;
+  if (report.full_resolution_step >= 0) {
+    block["full_resolution_step"] = report.full_resolution_step;
+  } else {
+    block["full_resolution_step"] = nullptr;
+  }
   if (settings.mode == HierarchyMode::precomputed) {
     const PrecomputedCut& cut = *settings.precomputed;
     nlohmann::json starts = nlohmann::json::array();
@@ -558,6 +564,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                      "limit or hysteresis)\n";
       }
     }
+  }
+  if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
+      adaptive && !options.quiet && adaptive->tolerance_report().full_resolution_step >= 0) {
+    log << "strata: the cut would have held more than "
+        << 100.0 * adaptive->settings().full_resolution_fraction
+        << " % of the finest level's tets after step "
+        << adaptive->tolerance_report().full_resolution_step
+        << ": the run went on at full resolution (hierarchy.full_resolution_fraction)\n";
   }
   if (!options.quiet) {
     log << "strata: done: " << summary.steps << " steps, " << summary.frames << " frames in "
