@@ -580,6 +580,8 @@ def summarise(args, spec):
                                           for c in hierarchy.get("changes", [])),
                 "redo_seconds": hierarchy.get("redo_seconds", 0.0),
                 "initial_adaptation_seconds": hierarchy.get("initial_adaptation_seconds", 0.0),
+                # the step after which an adaptive run went on at full resolution, or None
+                "full_resolution_step": hierarchy.get("full_resolution_step"),
                 "estimated_error": hierarchy.get("estimated_error"),
                 "tolerance_met": hierarchy.get("tolerance_met"),
                 "recorded_tolerance": hierarchy.get("precomputed", {}).get("recorded_tolerance"),

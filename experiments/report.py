@@ -115,6 +115,11 @@ def why_missed(runs, run):
                      "finer than the tolerance needs")
     overhead = sum(run.get(k) or 0.0 for k in ("cut_change_seconds", "redo_seconds",
                                                  "initial_adaptation_seconds"))
+    if run.get("full_resolution_step") is not None:
+        step = run["full_resolution_step"]
+        when = "before the first step" if step == 0 else f"after step {step}"
+        parts.append(f"its cut grew past hierarchy.full_resolution_fraction of the finest level "
+                     f"{when}, so it went on at full resolution")
     if run["kind"] == "adaptive" and run["wall_seconds"] > 0:
         parts.append(f"cut changes, redone steps and the initial adaptation took "
                      f"{100 * overhead / run['wall_seconds']:.0f} % of its time")

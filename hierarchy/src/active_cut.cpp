@@ -47,6 +47,26 @@ ActiveCut ActiveCut::uniform(TetTree& tree, int level) {
   return cut;
 }
 
+std::vector<NodeId> ActiveCut::depth_first_nodes() const {
+  std::vector<NodeId> order;
+  order.reserve(m_nodes.size());
+  std::vector<NodeId> stack;
+  for (NodeId root = static_cast<NodeId>(m_tree->num_roots()) - 1; root >= 0; --root)
+    stack.push_back(root);
+  while (!stack.empty()) {
+    const NodeId n = stack.back();
+    stack.pop_back();
+    if (is_active(n)) {
+      order.push_back(n);
+    } else if (!m_tree->is_leaf(n)) {
+      for (int k = 7; k >= 0; --k)
+        stack.push_back(m_tree->node(n).first_child + k);
+    }
+  }
+  STRATA_VERIFY(order.size() == m_nodes.size(), "depth_first_nodes: the cut is not a cut");
+  return order;
+}
+
 std::vector<NodeId> ActiveCut::sorted_nodes() const {
   std::vector<NodeId> sorted = m_nodes;
   std::sort(sorted.begin(), sorted.end());

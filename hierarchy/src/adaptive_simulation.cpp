@@ -635,13 +635,13 @@ bool AdaptiveSimulation::exceeds_full_resolution_fraction(const CutChanges& chan
 }
 
 CutChangeCounts AdaptiveSimulation::edit_to_full_resolution() {
+  // A node d levels above the deepest refines itself and its descendants above the deepest level:
+  // 1 + 8 + … + 8^(d−1) nodes.
   CutChangeCounts counts;
-  for (int level = m_cut->coarsest_level(); level < m_tree->max_level(); ++level)
-    for (NodeId n : std::vector<NodeId>(m_cut->nodes()))
-      if (m_tree->level(n) == level) {
-        m_cut->refine(n);
-        ++counts.refined;
-      }
+  for (NodeId n : m_cut->nodes())
+    for (Index d = m_tree->max_level() - m_tree->level(n), nodes = 1; d > 0; --d, nodes *= 8)
+      counts.refined += nodes;
+  m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, m_tree->max_level()));
   return counts;
 }
 

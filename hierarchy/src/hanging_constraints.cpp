@@ -256,7 +256,8 @@ VectorXd HangingConstraints::restrict_to_free(ConstRef<VectorXd> x) const {
 }
 
 ConstrainedCut flatten_cut(const ActiveCut& cut) {
-  FlatTreeMesh flat = flatten_nodes(cut.tree(), cut.nodes());
+  FlatTreeMesh flat =
+      flatten_nodes(cut.tree(), cut.depth_first_nodes(), VertexNumbering::first_use);
   HangingConstraints constraints(cut.tree(), flat);
   return {std::move(flat), std::move(constraints)};
 }

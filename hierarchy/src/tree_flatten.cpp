@@ -4,18 +4,22 @@
 
 namespace strata {
 
-FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes) {
+FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes,
+                           VertexNumbering numbering) {
   FlatTreeMesh flat;
   flat.tet_nodes = nodes;
   flat.mesh_vertices.assign(static_cast<std::size_t>(tree.vertex_capacity()), -1);
+  int count = 0;
   for (const NodeId n : nodes) {
     STRATA_VERIFY(tree.is_alive(n), "flatten_nodes: node is not alive");
     for (const int v : tree.bey_vertices(n))
-      flat.mesh_vertices[v] = 0;
+      if (flat.mesh_vertices[v] < 0) flat.mesh_vertices[v] = count++;
   }
-  int count = 0;
-  for (int& mesh_vertex : flat.mesh_vertices)
-    if (mesh_vertex == 0) mesh_vertex = count++;
+  if (numbering == VertexNumbering::tree_id) {
+    count = 0;
+    for (int& mesh_vertex : flat.mesh_vertices)
+      if (mesh_vertex >= 0) mesh_vertex = count++;
+  }
 
   flat.tree_vertices.resize(count);
   flat.mesh.vertices.resize(count, 3);

@@ -68,6 +68,43 @@ TEST(ActiveCut, RootsAndUniformLevels) {
   EXPECT_NO_THROW(roots.validate());
 }
 
+TEST(ActiveCut, DepthFirstNodesFollowTheTreeWhateverTheEditOrder) {
+  TetTree tree(test_box(), 3);
+  const ActiveCut uniform = ActiveCut::uniform(tree, 2);
+  EXPECT_EQ(uniform.depth_first_nodes(), uniform.nodes());  // the order uniform builds
+
+  // An edited cut: the swap-removal of refined nodes scrambles nodes(); depth_first_nodes lists
+  // the same nodes so that every root's and every parent's descendants are contiguous, in root
+  // and child order.
+  ActiveCut cut(tree);
+  cut.refine(cut.refine(40) + 6);
+  cut.refine(5);
+  cut.refine(cut.refine(17) + 1);
+  const std::vector<NodeId> order = cut.depth_first_nodes();
+  std::vector<NodeId> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, cut.sorted_nodes());
+  const auto root_of = [&](NodeId n) {
+    while (tree.parent(n) != kNoNode)
+      n = tree.parent(n);
+    return n;
+  };
+  // Ancestor path of each node as (root, child slots…): depth-first order is lexicographic.
+  const auto path = [&](NodeId n) {
+    std::vector<int> slots;
+    for (; tree.parent(n) != kNoNode; n = tree.parent(n))
+      slots.push_back(tree.node(n).child_slot);
+    slots.push_back(static_cast<int>(n));
+    std::reverse(slots.begin(), slots.end());
+    return slots;
+  };
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    EXPECT_LE(root_of(order[i - 1]), root_of(order[i]));
+    EXPECT_LT(path(order[i - 1]), path(order[i])) << "at " << i;
+  }
+  EXPECT_NE(order, cut.nodes());  // the edits did scramble nodes()
+}
+
 TEST(ActiveCut, ListConstructorValidates) {
   TetTree tree(test_box(), 2);
   const NodeId first = tree.refine(3);

@@ -270,6 +270,7 @@ TEST(CutMultigrid, RunsMatchCholmod) {
       solver.dt = 5e-3;
       solver.duration = 0.05;
       solver.load_steps = 3;
+      SCOPED_TRACE(std::string(dynamic ? "dynamic " : "static ") + to_string(mode));
       auto run = [&](LinearSolverKind kind) {
         solver.linear_solver = kind;
         AdaptiveSimulation sim(coarse, hierarchy, rubber, {clamp}, {}, std::nullopt,

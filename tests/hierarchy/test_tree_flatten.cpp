@@ -78,6 +78,39 @@ TEST(TreeFlatten, MapsLeadBackToTheTree) {
   EXPECT_EQ(remove_unreferenced_vertices(copy), 0);
 }
 
+TEST(TreeFlatten, FirstUseNumberingIsTheTreeIdNumberingPermuted) {
+  TetTree tree(box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {2, 2, 2}), 3);
+  tree.refine(tree.refine(30) + 3);
+  tree.refine(2);
+  const std::vector<NodeId> leaves = tree.leaves();
+  const FlatTreeMesh by_id = flatten_nodes(tree, leaves);
+  const FlatTreeMesh by_use = flatten_nodes(tree, leaves, VertexNumbering::first_use);
+  ASSERT_EQ(by_use.mesh.vertices.rows(), by_id.mesh.vertices.rows());
+  ASSERT_EQ(by_use.mesh.tets.rows(), by_id.mesh.tets.rows());
+  // Numbered by first use: scanning the tets in order, each new vertex is the next number.
+  int next = 0;
+  for (Index t = 0; t < by_use.mesh.tets.rows(); ++t)
+    for (int i = 0; i < 4; ++i) {
+      const int v = by_use.mesh.tets(t, i);
+      EXPECT_LE(v, next);
+      if (v == next) ++next;
+    }
+  EXPECT_EQ(next, by_use.mesh.vertices.rows());
+  // The same tree vertices, positions and tets, only renumbered.
+  for (Index t = 0; t < by_use.mesh.tets.rows(); ++t)
+    for (int i = 0; i < 4; ++i)
+      EXPECT_EQ(by_use.tree_vertices[by_use.mesh.tets(t, i)],
+                by_id.tree_vertices[by_id.mesh.tets(t, i)]);
+  for (Index v = 0; v < by_use.mesh.vertices.rows(); ++v) {
+    const int tree_vertex = by_use.tree_vertices[v];
+    EXPECT_EQ(by_use.mesh_vertices[tree_vertex], static_cast<int>(v));
+    EXPECT_EQ(by_use.mesh.vertices.row(v),
+              by_id.mesh.vertices.row(by_id.mesh_vertices[tree_vertex]));
+  }
+  // tree_id keeps increasing tree ids.
+  EXPECT_TRUE(std::is_sorted(by_id.tree_vertices.begin(), by_id.tree_vertices.end()));
+}
+
 TEST(TreeFlatten, AdaptiveLeavesHaveHangingVerticesOnly) {
   // One refined root among unrefined neighbours: the mesh tiles the box (volume), but faces on
   // the refined root's boundary shared with coarse neighbours are not matched (hanging vertices,

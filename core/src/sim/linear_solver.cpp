@@ -18,6 +18,8 @@ struct SpdSolver::Cycle {
   /// Uses A (same pattern) on the finest level from now on, where the cycle can.
   virtual void update_finest(const SparseMatrixd& A) = 0;
   virtual void apply(ConstRef<VectorXd> r, VectorXd& z) const = 0;
+  /// MultigridPreconditioner::widen_smoother_intervals.
+  virtual void widen_smoother_intervals() = 0;
   virtual double setup_seconds() const = 0;
   virtual int num_levels() const = 0;
 };
@@ -31,6 +33,7 @@ struct TreeCycle final : SpdSolver::Cycle {
   bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
   void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
+  void widen_smoother_intervals() override { preconditioner.widen_smoother_intervals(); }
   double setup_seconds() const override { return preconditioner.setup_seconds(); }
   int num_levels() const override { return preconditioner.num_levels(); }
 };
@@ -73,6 +76,7 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
     return ok;
   }
   void update_finest(const SparseMatrixd& A) override { cycle->update_finest(A); }
+  void widen_smoother_intervals() override { cycle->widen_smoother_intervals(); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { cycle->apply(r, z); }
   double setup_seconds() const override { return seconds; }
   int num_levels() const override { return cycle != nullptr ? cycle->num_levels() : 0; }
@@ -256,11 +260,21 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
   } else {
     m_multigrid->update_finest(A);
   }
-  int iterations = multigrid_pcg(A, b, x);
+  // A V-cycle found indefinite: a smoother's eigenvalue estimate missed the top of the spectrum;
+  // the smoothers widened to the row-sum bound try once more.
+  auto pcg = [&] {
+    int result = multigrid_pcg(A, b, x);
+    if (result == -3) {
+      m_multigrid->widen_smoother_intervals();
+      result = multigrid_pcg(A, b, x);
+    }
+    return result == -3 ? -1 : result;
+  };
+  int iterations = pcg();
   if (iterations == -1 && !fresh) {
     // Stale coarse levels: set up on this matrix and try once more.
     if (!setup()) return direct();
-    iterations = multigrid_pcg(A, b, x);
+    iterations = pcg();
   }
   if (iterations == -1) return direct();  // no convergence on a fresh hierarchy
   if (iterations < 0) {                   // negative curvature: A is not positive definite
@@ -292,7 +306,7 @@ int SpdSolver::multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, Vecto
   for (int k = 0; k < m_max_iterations; ++k) {
     symmetric_product(A, p, Ap);
     const double curvature = p.dot(Ap);
-    if (!(rz > 0.0)) return -1;  // the preconditioner, not A, is not positive definite
+    if (!(rz > 0.0)) return -3;  // the preconditioner, not A, is not positive definite
     if (!(curvature > 0.0)) return -2;
     const double alpha = rz / curvature;
     x += alpha * p;

@@ -183,6 +183,22 @@ SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
   return C;
 }
 
+namespace {
+
+/// max_j Σ_i |A_ij| / A_jj: the row-sum (Gershgorin) bound of the spectrum of D⁻¹A.
+double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal) {
+  double bound = 0.0;
+  for (Index j = 0; j < A.outerSize(); ++j) {
+    double sum = 0.0;
+    for (SparseMatrixd::InnerIterator it(A, j); it; ++it)
+      sum += std::abs(it.value());
+    bound = std::max(bound, sum * inverse_diagonal[j]);
+  }
+  return bound;
+}
+
+}  // namespace
+
 struct MultigridPreconditioner::Level {
   SparseMatrixd owned;               ///< coarse Galerkin operator (empty on the finest level)
   const SparseMatrixd* A = nullptr;  ///< the operator of this level
@@ -312,15 +328,18 @@ void MultigridPreconditioner::setup_smoother(Level& level) {
   // A Ritz value bounds λ_max from below; the Chebyshev polynomial stays below 1 in magnitude
   // up to 2θ = upper + lower, so the upper end gets a margin, capped by the row-sum (Gershgorin)
   // bound of D⁻¹A, which holds for any matrix.
-  double gershgorin = 0.0;
-  for (Index j = 0; j < A.outerSize(); ++j) {
-    double sum = 0.0;
-    for (SparseMatrixd::InnerIterator it(A, j); it; ++it)
-      sum += std::abs(it.value());
-    gershgorin = std::max(gershgorin, sum * level.inverse_diagonal[j]);
-  }
+  const double gershgorin = row_sum_bound(A, level.inverse_diagonal);
   level.lambda_max = std::min(1.2 * lambda, std::max(gershgorin, lambda));
   level.lambda_min = m_options.chebyshev_lower * lambda;
+}
+
+void MultigridPreconditioner::widen_smoother_intervals() {
+  for (int k = 1; k < num_levels(); ++k) {  // level 0 is solved directly
+    Level& level = *m_levels[k];
+    if (level.A != nullptr && level.inverse_diagonal.size() == level.A->rows())
+      level.lambda_max =
+          std::max(level.lambda_max, row_sum_bound(*level.A, level.inverse_diagonal));
+  }
 }
 
 void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, VectorXd& x,

@@ -44,6 +44,10 @@ class ActiveCut {
   const std::vector<NodeId>& nodes() const { return m_nodes; }
   /// Active nodes in ascending id.
   std::vector<NodeId> sorted_nodes() const;
+  /// Active nodes in depth-first order of the tree, root by root and child by child (for a
+  /// uniform cut, the order of `uniform`): nodes near each other in space are mostly near each
+  /// other in the list, whatever order the cut was edited in.
+  std::vector<NodeId> depth_first_nodes() const;
   Index size() const { return static_cast<Index>(m_nodes.size()); }
   bool is_active(NodeId n) const;
   /// Deepest / shallowest level among the active nodes.

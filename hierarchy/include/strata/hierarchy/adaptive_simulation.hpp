@@ -24,6 +24,11 @@
 ///   refinement) → release coarsened subtrees (memory follows the active cut) → a new Simulation
 ///   that continues the clock (first_step) from the transferred state.
 ///
+/// Full resolution when the cut is nearly full: when a refinement would make the cut hold more
+/// than HierarchySettings::full_resolution_fraction of the finest level's tets, every node goes to
+/// the deepest level (the same transfer as any refinement) and the run goes on there without
+/// estimates or cut changes (ToleranceReport::full_resolution_step).
+///
 /// Explicit integrators: refinement of a node is refused (vetoed) when its children's stable step
 /// estimate (stable_time_step.hpp) falls below the scene's dt; the time step is never changed, so
 /// outputs stay on the scene's time grid. If exact fixed/prescribed regions need such a level, the

@@ -97,7 +97,9 @@ struct ConstrainedCut {
   HangingConstraints constraints;
 };
 
-/// One-shot: `flatten_nodes(cut.tree(), cut.nodes())` and its HangingConstraints.
+/// One-shot: the cut's nodes flattened in depth-first order with vertices numbered by first use
+/// (`flatten_nodes(cut.tree(), cut.depth_first_nodes(), VertexNumbering::first_use)`: nearby
+/// vertices get nearby numbers on every cut), and its HangingConstraints.
 ConstrainedCut flatten_cut(const ActiveCut& cut);
 
 }  // namespace strata

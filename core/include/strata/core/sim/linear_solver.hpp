@@ -130,7 +130,8 @@ class SpdSolver {
   bool solve_with_previous_factor(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   bool solve_cholmod(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
   bool solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
-  /// PCG with the V-cycle; returns iterations, or −1 (no convergence), −2 (negative curvature).
+  /// PCG with the V-cycle; returns iterations, or −1 (no convergence), −2 (negative curvature of
+  /// A), −3 (the V-cycle is not positive definite).
   int multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
 };
 

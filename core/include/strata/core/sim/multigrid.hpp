@@ -87,6 +87,11 @@ class MultigridPreconditioner {
   void update_finest(const SparseMatrixd& A);
   /// z = one V-cycle applied to r.
   void apply(ConstRef<VectorXd> r, VectorXd& z) const;
+  /// Every level's Chebyshev interval up to the row-sum (Gershgorin) bound of D⁻¹A, which holds
+  /// for any matrix: for when a Lanczos estimate missed the top of a spectrum (a V-cycle that PCG
+  /// finds indefinite). The smoothers then damp the whole spectrum and the cycle is positive
+  /// definite, at slower smoothing, until the next setup().
+  void widen_smoother_intervals();
 
   int num_levels() const { return static_cast<int>(m_levels.size()); }
   /// Unknowns per level, coarsest first.
