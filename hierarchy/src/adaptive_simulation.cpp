@@ -273,13 +273,6 @@ void AdaptiveSimulation::initial_adaptation() {
     changes.coarsen.clear();
     m_report.refused_refinements += changes.refused;
     if (changes.refine.empty()) break;
-    if (exceeds_full_resolution_fraction(changes)) {
-      m_report.initial_refinements += static_cast<int>(edit_to_full_resolution().refined);
-      m_report.full_resolution_step = 0;
-      m_at_full_resolution = true;
-      changed = true;
-      break;
-    }
     if (m_obstacles.empty()) {
       previous_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
       previous_positions = solve->positions();
@@ -287,6 +280,12 @@ void AdaptiveSimulation::initial_adaptation() {
     const CutChangeCounts counts = m_controller->apply(*m_cut, changes, 0);
     m_report.initial_refinements += static_cast<int>(counts.refined + counts.balance_refined);
     changed = true;
+    if (past_full_resolution_fraction()) {
+      m_report.initial_refinements += static_cast<int>(edit_to_full_resolution());
+      m_report.full_resolution_step = 0;
+      m_at_full_resolution = true;
+      break;
+    }
   }
   if (changed) rebuild(0);
   m_report.initial_adaptation_seconds = seconds_since(start);
@@ -560,15 +559,12 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.momentum_before = old_momentum;
   const VectorXd old_positions = x_mesh;
   const VectorXd old_velocities = v_mesh;
-  const bool to_full_resolution = exceeds_full_resolution_fraction(changes);
-  const CutChangeCounts counts = to_full_resolution
-                                     ? edit_to_full_resolution()
-                                     : m_controller->apply(*m_cut, changes, sim.step_count());
-  if (to_full_resolution) {
-    m_at_full_resolution = true;
-    m_report.full_resolution_step = first_step;
-  }
-  record.refined = counts.refined + counts.balance_refined;
+  // The cut before the change, restored if the change fails.
+  const ActiveCut cut_before = *m_cut;
+  const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
+  const bool to_full_resolution = !changes.refine.empty() && past_full_resolution_fraction();
+  const Index full_resolution_refined = to_full_resolution ? edit_to_full_resolution() : 0;
+  record.refined = counts.refined + counts.balance_refined + full_resolution_refined;
   record.coarsened = counts.coarsened;
 
   // The new objects are built aside and swapped in only when complete: an exception leaves the
@@ -591,12 +587,17 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
                         old_kinetic_energy, old_momentum);
     if (!m_obstacles.empty()) record.contact_correction = m_simulation->push_out_of_obstacles();
   } catch (...) {
+    *m_cut = cut_before;
     m_constrained = std::move(old_cut);
     m_simulation = std::move(old_simulation);
     m_mesh_external = std::move(old_mesh_external);
     m_load_traction = std::move(old_load_traction);
     m_failed = true;
     throw;
+  }
+  if (to_full_resolution) {
+    m_at_full_resolution = true;
+    m_report.full_resolution_step = first_step;
   }
   SimulationCounters old_counters = old_simulation->counters();
   if (first_step < old_simulation->step_count()) old_counters.steps -= 1;  // a redone step
@@ -619,30 +620,26 @@ bool AdaptiveSimulation::adapting() const {
   return m_settings.mode == HierarchyMode::adaptive && !m_at_full_resolution;
 }
 
-bool AdaptiveSimulation::exceeds_full_resolution_fraction(const CutChanges& changes) const {
+bool AdaptiveSimulation::past_full_resolution_fraction() const {
   if (m_settings.mode != HierarchyMode::adaptive || m_settings.full_resolution_fraction >= 1.0 ||
-      changes.refine.empty() || is_explicit(m_solver) || max_refine_level() < m_tree->max_level())
+      is_explicit(m_solver) || max_refine_level() < m_tree->max_level())
     return false;
   const double finest = static_cast<double>(m_tree->num_roots()) *
                         std::pow(8.0, static_cast<double>(m_tree->max_level()));
   const Index budget = m_settings.criteria.max_active_elements;
   if (budget > 0 && static_cast<double>(budget) < finest) return false;
-  // A refinement replaces one tet by eight; a merge, eight by one.
-  const double after = static_cast<double>(m_cut->size()) +
-                       7.0 * static_cast<double>(changes.refine.size()) -
-                       7.0 * static_cast<double>(changes.coarsen.size());
-  return after > m_settings.full_resolution_fraction * finest;
+  return static_cast<double>(m_cut->size()) > m_settings.full_resolution_fraction * finest;
 }
 
-CutChangeCounts AdaptiveSimulation::edit_to_full_resolution() {
+Index AdaptiveSimulation::edit_to_full_resolution() {
   // A node d levels above the deepest refines itself and its descendants above the deepest level:
   // 1 + 8 + … + 8^(d−1) nodes.
-  CutChangeCounts counts;
+  Index refined = 0;
   for (NodeId n : m_cut->nodes())
     for (Index d = m_tree->max_level() - m_tree->level(n), nodes = 1; d > 0; --d, nodes *= 8)
-      counts.refined += nodes;
-  m_cut = std::make_unique<ActiveCut>(ActiveCut::uniform(*m_tree, m_tree->max_level()));
-  return counts;
+      refined += nodes;
+  *m_cut = ActiveCut::uniform(*m_tree, m_tree->max_level());
+  return refined;
 }
 
 int AdaptiveSimulation::max_refine_level() const {

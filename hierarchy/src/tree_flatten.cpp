@@ -12,7 +12,7 @@ FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes
   int count = 0;
   for (const NodeId n : nodes) {
     STRATA_VERIFY(tree.is_alive(n), "flatten_nodes: node is not alive");
-    for (const int v : tree.bey_vertices(n))
+    for (const int v : tree.tet_vertices(n))
       if (flat.mesh_vertices[v] < 0) flat.mesh_vertices[v] = count++;
   }
   if (numbering == VertexNumbering::tree_id) {

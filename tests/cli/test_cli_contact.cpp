@@ -136,13 +136,14 @@ TEST(CliContact, BadObstaclesNameTheirKey) {
 
 TEST(CliContact, AdaptiveDropOnASphereFollowsFullResolution) {
   // The drop on the hierarchy: the adaptive run (levels 1, τ = 0.01) stays within the contact
-  // tolerance, refines near the contact, and its probe follows the full-resolution run's.
+  // tolerance, refines near the contact, and its probe follows the full-resolution run's. The cut
+  // adapts however large it grows (full_resolution_fraction 1): the test follows it.
   TempFolder folder;
   for (const char* mode : {"full", "adaptive"}) {
     json scene = drop_scene();
     scene["solver"]["duration"] = 0.25;
     scene["output"]["every"] = 10;
-    scene["hierarchy"] = {{"levels", 1}, {"mode", mode}};
+    scene["hierarchy"] = {{"levels", 1}, {"mode", mode}, {"full_resolution_fraction", 1.0}};
     write_text(folder.path() / (std::string(mode) + ".json"), scene.dump(2));
     const CliResult result =
         run_strata(std::string("run ") + mode + ".json --quiet", folder.path());

@@ -72,10 +72,11 @@ TEST(CliPlasticity, BentBeyondYieldTheBracketKeepsAPermanentSet) {
 
 TEST(CliPlasticity, AdaptiveCutCarriesThePlasticStateLikeTheFullRun) {
   // One level of refinement: the adaptive run refines where the bracket yields, carries the
-  // plastic state across its cut changes and ends where the full-resolution run ends.
+  // plastic state across its cut changes and ends where the full-resolution run ends. The cut
+  // adapts however large it grows (full_resolution_fraction 1): the test follows it.
   TempFolder folder;
   json scene = bracket_scene(true);
-  scene["hierarchy"] = {{"levels", 1}};
+  scene["hierarchy"] = {{"levels", 1}, {"full_resolution_fraction", 1.0}};
   scene["output"]["vtk"] = false;
   write_text(folder.path() / "bracket.json", scene.dump(2));
   const CliResult full = run_strata(

@@ -123,5 +123,46 @@ TEST(Multigrid, VCycleIsSymmetricPositiveDefinite) {
   }
 }
 
+TEST(Multigrid, WideningTheSmoothersMakesAnIndefiniteCyclePositiveDefinite) {
+  // One Lanczos step estimates the top of D⁻¹A's spectrum from a random vector: near its middle,
+  // so the smoothers' Chebyshev interval misses the top and the V-cycle is indefinite along the
+  // top eigenvector. Widening the intervals to the row-sum bound makes it definite again.
+  std::mt19937 random(5u);
+  const SparseMatrixd A = random_spd(2000, 6, random);
+  std::vector<SparseMatrixd> prolongations;
+  prolongations.push_back(random_prolongation(400, 80, random));
+  prolongations.push_back(random_prolongation(2000, 400, random));
+  MultigridOptions options;
+  options.lanczos_iterations = 1;
+  MultigridPreconditioner mg(prolongations, options);
+  ASSERT_TRUE(mg.setup(A));
+  // The top eigenvector of D⁻¹A by power iteration (in the D-inner product).
+  const VectorXd diagonal = A.diagonal();
+  VectorXd v = VectorXd::Ones(A.rows());
+  for (int it = 0; it < 500; ++it) {
+    v = (A * v).cwiseQuotient(diagonal);
+    v /= v.norm();
+  }
+  const VectorXd r = A * v;
+  VectorXd z;
+  mg.apply(r, z);
+  ASSERT_LT(r.dot(z), 0.0) << "the cycle of one Lanczos step is not indefinite here";
+  mg.widen_smoother_intervals();
+  mg.apply(r, z);
+  EXPECT_GT(r.dot(z), 0.0);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    VectorXd r1(A.rows()), r2(A.rows()), z1, z2;
+    for (Index i = 0; i < A.rows(); ++i) {
+      r1[i] = value(random);
+      r2[i] = value(random);
+    }
+    mg.apply(r1, z1);
+    mg.apply(r2, z2);
+    EXPECT_NEAR(r2.dot(z1), r1.dot(z2), 1e-10 * r1.norm() * z2.norm());
+    EXPECT_GT(r1.dot(z1), 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace strata

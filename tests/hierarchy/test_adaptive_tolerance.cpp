@@ -68,9 +68,13 @@ struct PokedPlate {
   }
 };
 
+/// The default settings at `levels`, except that the cut adapts however large it grows: the plate's
+/// cuts pass the default full_resolution_fraction, which would leave these tests nothing adaptive
+/// to test (the switch has tests of its own below).
 HierarchySettings defaults(int levels) {
   HierarchySettings h;
   h.levels = levels;
+  h.full_resolution_fraction = 1.0;
   return h;
 }
 
@@ -107,6 +111,7 @@ TEST(AdaptiveTolerance, DefaultsStayWithinTheToleranceOfFullResolution) {
   EXPECT_GE(report.initial_newton_iterations, report.initial_passes);
   EXPECT_EQ(report.steps_over_tolerance, 0);
   EXPECT_LE(report.max_estimated_error, h.tolerance);
+  EXPECT_EQ(report.full_resolution_step, -1);  // the cut stayed adaptive
   // The uniform coarse cut is far off: the scene needs the refinement.
   HierarchySettings coarse = defaults(2);
   coarse.mode = HierarchyMode::uniform;
@@ -120,8 +125,10 @@ TEST(AdaptiveTolerance, ErrorFallsMonotonicallyWithTheTolerance) {
   for (double tolerance : {0.5, 0.2, 0.05}) {
     HierarchySettings h = defaults(2);
     h.tolerance = tolerance;
-    const double error = run_error(plate.run(h), full);
+    ToleranceReport report;
+    const double error = run_error(plate.run(h, &report), full);
     EXPECT_LE(error, previous * (1 + 1e-9)) << "tolerance " << tolerance;
+    EXPECT_EQ(report.full_resolution_step, -1) << "tolerance " << tolerance;
     previous = error;
   }
 }
@@ -137,6 +144,7 @@ TEST(AdaptiveTolerance, InStepRefinementRedoesStepsWithoutAnInitialAdaptation) {
   long steps = 0;
   const std::vector<MatrixX3d> adaptive = plate.run(h, &report, &initial_tets, &steps);
   EXPECT_EQ(initial_tets, plate.coarse.tets.rows());
+  EXPECT_EQ(report.full_resolution_step, -1);  // the redone steps were on adaptive cuts
   EXPECT_GT(report.redone_steps, 0);
   EXPECT_EQ(steps, static_cast<long>(adaptive.size()));  // a redone step counts once
   EXPECT_GT(report.redo_seconds, 0.0);

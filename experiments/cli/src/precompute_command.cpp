@@ -63,6 +63,8 @@ void run_precompute_command(const PrecomputeCommand& command, std::ostream& log)
     std::vector<std::string> overrides = command.overrides;
     overrides.push_back("hierarchy.mode=\"adaptive\"");
     overrides.push_back("hierarchy.tolerance=" + json_number(run_tolerance));
+    // The schedule records adaptive cuts, however large they grow.
+    overrides.push_back("hierarchy.full_resolution_fraction=1");
     overrides.push_back("output.vtk=false");
     const Scene scene = load_scene(file, overrides);
     const PreparedMesh prepared = prepare_scene_mesh(scene);

@@ -90,11 +90,11 @@ struct HierarchySettings {
   /// Dynamic runs: test each step's result and redo the step on the refined cut (from the
   /// start-of-step state) where the criteria fail; false: refine every `adapt_every` steps.
   bool in_step_refinement = true;
-  /// Adaptive runs: when a refinement would make the cut hold more than this fraction of the
+  /// Adaptive runs: when a refinement leaves the cut holding more than this fraction of the
   /// finest level's tets, the run continues at full resolution (every node at the deepest level,
   /// no more estimates or cut changes): a cut that large costs more than full resolution (hanging
   /// vertices, estimates, redone steps and cut changes; README, "Error control"). 1: never.
-  /// Not with explicit integrators, an element budget below the finest level, or max_level above
+  /// Not with explicit integrators, an element budget below the finest level, or max_level below
   /// the tree's depth.
   double full_resolution_fraction = 0.85;
   /// `criteria.refine_threshold` was given explicitly (an expert override of the tolerance rule).
@@ -159,8 +159,9 @@ struct ToleranceReport {
   int initial_passes = 0;              ///< static solves of the initial adaptation
   long initial_newton_iterations = 0;  ///< Newton iterations of those solves
   double initial_adaptation_seconds = 0.0;
-  /// The step after which the run went on at full resolution (HierarchySettings::
-  /// full_resolution_fraction; 0: before the first step), or −1.
+  /// When the run went on at full resolution (HierarchySettings::full_resolution_fraction), or
+  /// −1: 0 before the first step; a dynamic run redid step n + 1 at full resolution (n here) or
+  /// changed after step n; a static run solved load step n again at full resolution.
   long full_resolution_step = -1;
 };
 
@@ -266,11 +267,11 @@ class AdaptiveSimulation final : public SimulationRun {
   bool m_at_full_resolution = false;
   /// Whether the run adapts its cut now (mode adaptive, not yet at full resolution).
   bool adapting() const;
-  /// Whether `changes` would take the cut past full_resolution_fraction of the finest level (and
-  /// the run may go to full resolution).
-  bool exceeds_full_resolution_fraction(const CutChanges& changes) const;
-  /// Makes the cut every node at the deepest level; the counts of the change.
-  CutChangeCounts edit_to_full_resolution();
+  /// Whether the cut holds more than full_resolution_fraction of the finest level's tets and the
+  /// run may go on at full resolution.
+  bool past_full_resolution_fraction() const;
+  /// Makes the cut every node at the deepest level; the nodes it refined.
+  Index edit_to_full_resolution();
   void record_sample();
   /// Obstacles: the contact record of the step just accepted (before a coarsening rebuilds the
   /// Simulation).

@@ -45,7 +45,7 @@ struct HangingVertex {
 };
 
 /// All hanging vertices of `flat` (a flattened valid cut of `tree`), ordered so that parents come
-/// before the vertices that depend on them (increasing tree vertex level, then id).
+/// before the vertices that depend on them (increasing tree vertex level, then mesh vertex).
 std::vector<HangingVertex> find_hanging_vertices(const TetTree& tree, const FlatTreeMesh& flat);
 
 /// The embedding x = C q of a flattened cut; built once per cut (rebuild after refine/coarsen).
