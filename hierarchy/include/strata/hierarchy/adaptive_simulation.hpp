@@ -24,7 +24,7 @@
 ///   refinement) → release coarsened subtrees (memory follows the active cut) → a new Simulation
 ///   that continues the clock (first_step) from the transferred state.
 ///
-/// Full resolution when the cut is nearly full: when a refinement would make the cut hold more
+/// Full resolution when the cut is nearly full: when a refinement leaves the cut holding more
 /// than HierarchySettings::full_resolution_fraction of the finest level's tets, every node goes to
 /// the deepest level (the same transfer as any refinement) and the run goes on there without
 /// estimates or cut changes (ToleranceReport::full_resolution_step).
