@@ -16,6 +16,7 @@
 #include "strata/hierarchy/red_refinement.hpp"
 #include "strata/hierarchy/refinement_indicator_registry.hpp"
 #include "strata/hierarchy/refinement_recovery_estimator.hpp"
+#include "strata/hierarchy/tree_size.hpp"
 
 namespace strata {
 namespace {
@@ -624,8 +625,8 @@ bool AdaptiveSimulation::past_full_resolution_fraction() const {
   if (m_settings.mode != HierarchyMode::adaptive || m_settings.full_resolution_fraction >= 1.0 ||
       is_explicit(m_solver) || max_refine_level() < m_tree->max_level())
     return false;
-  const double finest = static_cast<double>(m_tree->num_roots()) *
-                        std::pow(8.0, static_cast<double>(m_tree->max_level()));
+  const auto finest = static_cast<double>(
+      potential_leaf_count(static_cast<std::uint64_t>(m_tree->num_roots()), m_tree->max_level()));
   const Index budget = m_settings.criteria.max_active_elements;
   if (budget > 0 && static_cast<double>(budget) < finest) return false;
   return static_cast<double>(m_cut->size()) > m_settings.full_resolution_fraction * finest;

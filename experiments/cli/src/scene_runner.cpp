@@ -570,7 +570,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     const long step = adaptive->tolerance_report().full_resolution_step;
     log << "strata: the cut would have held more than "
         << 100.0 * adaptive->settings().full_resolution_fraction << " % of the finest level's tets "
-        << (step == 0 ? std::string("before the first step") : "at step " + std::to_string(step))
+        << (step == 0 ? std::string("before the first step") : "after step " + std::to_string(step))
         << ": the run went on at full resolution (hierarchy.full_resolution_fraction)\n";
   }
   if (!options.quiet) {
