@@ -6,9 +6,15 @@
 // timed steps follow it as consecutive steps of the running simulation (the box sags under
 // gravity, so each step's matrices differ). Names:
 // tree_implicit_euler_step/<solver>/tets:<#T>/threads:<n>.
-// Counters: Newton iterations, CG iterations and multigrid setups per timed step, DOFs, levels,
-// the wall time of all multigrid setups (the warm-up step's included) and of the warm-up step
-// (first_step_seconds: with CHOLMOD its first factorisation).
+// A second family, tree_implicit_euler_step_scaled_dt/multigrid/tets:<#T>/threads:<n>, runs the
+// multigrid steps with dt = 1 ms · 2^(4−L), i.e. dt proportional to the edge length h. The Newton
+// matrix M/dt² + K then keeps its balance of inertia (∝ ρh³/dt²) and stiffness (∝ Eh) across the
+// sizes, which separates the multigrid's dependence on h from the change of the operator: at a
+// fixed 1 ms the 48k box is inertia-dominated (ρh²/(E dt²) ≈ 2.5, h the cell size / 2^L) and the 3M
+// box stiffness-dominated (≈ 0.16), and CG needs more iterations on the stiffer operator at any
+// size. Counters: Newton iterations, CG iterations and multigrid setups per timed step, DOFs,
+// levels, the wall time of all multigrid setups (the warm-up step's included) and of the warm-up
+// step (first_step_seconds: with CHOLMOD its first factorisation).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -57,7 +63,8 @@ const TreeBox& tree_box(int level) {
   return box;
 }
 
-void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind solver, int threads) {
+void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind solver, int threads,
+                         double dt) {
   set_thread_policy({.threads = threads});
   const TreeBox& box = tree_box(level);
   const ElasticModel& model = *box.model;
@@ -82,7 +89,8 @@ void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind so
                         .ramp_time = 1.0,
                         .diagonal = std::sqrt(3.0),
                         .nested_spaces = &box.spaces};
-  const SolverSettings settings;
+  SolverSettings settings;
+  settings.dt = dt;
   ImplicitEuler stepper(problem, solver,
                         {newton_iteration_limit(settings, false), settings.newton_tolerance});
 
@@ -114,6 +122,7 @@ void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind so
   state.counters["tets"] = double(model.num_tets());
   state.counters["dofs"] = double(model.num_dofs());
   state.counters["threads"] = threads;
+  state.counters["dt_ms"] = dt * 1e3;
   state.counters["newton_iterations"] = double(newton_iterations) / n;
   state.counters["cg_iterations"] = double(stepper.linear_solver().cg_iterations() - cg_start) / n;
   state.counters["multigrid_setups"] =
@@ -135,11 +144,23 @@ const bool registered = [] {
         const std::string name = "tree_implicit_euler_step/" + to_string(solver) +
                                  "/tets:" + std::to_string(tets) +
                                  "/threads:" + std::to_string(threads);
-        benchmark::internal::Benchmark* b =
-            benchmark::RegisterBenchmark(name.c_str(), tree_step_benchmark, level, solver, threads);
+        benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+            name.c_str(), tree_step_benchmark, level, solver, threads, 1e-3);
         b->Unit(benchmark::kMillisecond)->UseRealTime();
         b->Iterations(level >= 4 ? 2 : level == 3 ? 4 : 10);
       }
+    }
+  for (int level : {2, 3, 4})
+    for (int threads : thread_counts()) {
+      const long long tets = 750LL << (3 * level);
+      const std::string name =
+          "tree_implicit_euler_step_scaled_dt/multigrid/tets:" + std::to_string(tets) +
+          "/threads:" + std::to_string(threads);
+      benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+          name.c_str(), tree_step_benchmark, level, LinearSolverKind::multigrid, threads,
+          1e-3 * (1 << (4 - level)));
+      b->Unit(benchmark::kMillisecond)->UseRealTime();
+      b->Iterations(level >= 4 ? 2 : level == 3 ? 4 : 10);
     }
   return true;
 }();
