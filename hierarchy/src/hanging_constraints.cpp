@@ -37,19 +37,33 @@ class BoundaryWalker {
       : m_tree(tree), m_mesh_vertices(flat.mesh_vertices), m_records(records) {}
 
   void walk(NodeId node) {
+    // A tet at the tree's deepest level has no edge midpoints: nothing lies on its boundary.
+    if (m_tree.level(node) >= m_tree.max_level()) return;
     m_node = node;
     const std::array<int, 4>& v = m_tree.bey_vertices(node);
-    for (const auto& e : kTetEdges)
-      walk_edge(v[e[0]], v[e[1]]);
+    // Each edge's midpoint is looked up once; the faces' walks start from them.
+    std::array<int, 6> mid{};
+    bool any = false;
+    for (int e = 0; e < 6; ++e) {
+      mid[e] = m_tree.midpoint(v[kTetEdges[e][0]], v[kTetEdges[e][1]]);
+      any = any || is_mesh_vertex(mid[e]);
+    }
+    if (!any) return;  // no mesh vertex on an edge, hence none inside a face
+    for (int e = 0; e < 6; ++e)
+      walk_edge(v[kTetEdges[e][0]], v[kTetEdges[e][1]], mid[e]);
     for (const auto& f : kTetFaces)
-      walk_face_interior(v[f[0]], v[f[1]], v[f[2]]);
+      walk_face_interior(v[f[0]], v[f[1]], v[f[2]], mid[edge_index(f[0], f[1])],
+                         mid[edge_index(f[0], f[2])], mid[edge_index(f[1], f[2])]);
   }
 
  private:
+  // The position of the tet edge {i, j} (i < j) in kTetEdges.
+  static constexpr int edge_index(int i, int j) { return i == 0 ? j - 1 : i + j; }
+
   // Mesh vertices on the open segment a–b: its midpoint and, recursively, those of the halves.
   // A mesh vertex's parents are mesh vertices, so the walk stops at a midpoint outside the mesh.
-  void walk_edge(int a, int b) {
-    const int m = m_tree.midpoint(a, b);
+  void walk_edge(int a, int b) { walk_edge(a, b, m_tree.midpoint(a, b)); }
+  void walk_edge(int a, int b, int m) {
     if (!is_mesh_vertex(m)) return;
     record(m);
     walk_edge(a, m);
@@ -60,9 +74,10 @@ class BoundaryWalker {
   // three edge midpoints exist; every vertex inside descends (through parents) from one of them,
   // so the walk stops when none of them is a mesh vertex.
   void walk_face_interior(int a, int b, int c) {
-    const int ab = m_tree.midpoint(a, b);
-    const int ac = m_tree.midpoint(a, c);
-    const int bc = m_tree.midpoint(b, c);
+    walk_face_interior(a, b, c, m_tree.midpoint(a, b), m_tree.midpoint(a, c),
+                       m_tree.midpoint(b, c));
+  }
+  void walk_face_interior(int a, int b, int c, int ab, int ac, int bc) {
     if (ab < 0 || ac < 0 || bc < 0) return;
     if (!is_mesh_vertex(ab) && !is_mesh_vertex(ac) && !is_mesh_vertex(bc)) return;
     walk_edge(ab, ac);

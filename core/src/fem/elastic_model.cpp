@@ -70,9 +70,10 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
   m_partition = build_tet_partition(rest_positions, tets);
   const Index num_tets = tets.rows();
   m_sorted_tets.resize(4 * num_tets);
-  for (Index i = 0; i < num_tets; ++i)
+  tbb::parallel_for(Index(0), num_tets, [&](Index i) {
     for (int k = 0; k < 4; ++k)
       m_sorted_tets[4 * i + k] = tets(m_partition.order[i], k);
+  });
   fill_rest_arrays();
   build_stiffness_pattern();
 }
@@ -82,7 +83,7 @@ void ElasticModel::fill_rest_arrays() {
   m_sorted_Dm_inv.resize(9 * num_tets);
   m_sorted_volume.resize(num_tets);
   m_sorted_Dm_inv_det.resize(num_tets);
-  for (Index i = 0; i < num_tets; ++i) {
+  tbb::parallel_for(Index(0), num_tets, [&](Index i) {
     const int t = m_partition.order[i];
     Eigen::Map<Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
     if (m_plastic_inverse.empty())
@@ -91,19 +92,19 @@ void ElasticModel::fill_rest_arrays() {
       Dm_inv = m_rest.Dm_inv[t] * m_plastic_inverse[t];
     m_sorted_volume[i] = m_rest.rest_volume[t];
     m_sorted_Dm_inv_det[i] = Dm_inv.determinant();
-  }
+  });
   // Rest data regrouped for the vectorised kernels, one contiguous block per lane group g: entry
   // (j, c) of Dm⁻¹ of its kLanes tets at [g · kLaneRest + (3c + j) · kLanes + lane], then the rest
   // volumes at [g · kLaneRest + 9 · kLanes + lane].
   static_assert(kLaneRest == 10 * detail::kLanes);
   const Index num_groups = (num_tets + detail::kLanes - 1) / detail::kLanes;
   m_lane_rest.assign(kLaneRest * num_groups, 0.0);
-  for (Index i = 0; i < num_tets; ++i) {
+  tbb::parallel_for(Index(0), num_tets, [&](Index i) {
     double* group = &m_lane_rest[kLaneRest * (i / detail::kLanes)];
     for (int entry = 0; entry < 9; ++entry)
       group[entry * detail::kLanes + i % detail::kLanes] = m_sorted_Dm_inv[9 * i + entry];
     group[9 * detail::kLanes + i % detail::kLanes] = m_sorted_volume[i];
-  }
+  });
 }
 
 void ElasticModel::set_plastic_inverse(const std::vector<Matrix3d>& plastic_inverse) {

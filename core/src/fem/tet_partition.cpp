@@ -66,22 +66,39 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
   partition.chunk_begin.push_back(static_cast<int>(num_tets));
   const Index num_chunks = partition.num_chunks();
 
-  // Chunks touching each vertex, then greedy colouring in chunk order.
-  std::vector<std::vector<int>> vertex_chunks(positions.rows());
-  for (Index c = 0; c < num_chunks; ++c)
+  // Chunks touching each vertex (compressed lists, ascending), then greedy colouring in chunk
+  // order. `seen[v] == c` marks vertex v as visited for chunk c.
+  const Index num_vertices = positions.rows();
+  std::vector<int> seen(num_vertices, -1);
+  std::vector<int> start(num_vertices + 1, 0);
+  const auto for_each_chunk_vertex = [&](Index c, auto&& body) {
     for (int i = partition.chunk_begin[c]; i < partition.chunk_begin[c + 1]; ++i)
       for (int k = 0; k < 4; ++k) {
-        auto& chunks = vertex_chunks[tets(partition.order[i], k)];
-        if (chunks.empty() || chunks.back() != c) chunks.push_back(static_cast<int>(c));
+        const int v = tets(partition.order[i], k);
+        if (seen[v] == c) continue;
+        seen[v] = static_cast<int>(c);
+        body(v);
       }
+  };
+  for (Index c = 0; c < num_chunks; ++c)
+    for_each_chunk_vertex(c, [&](int v) { ++start[v + 1]; });
+  for (Index v = 0; v < num_vertices; ++v)
+    start[v + 1] += start[v];
+  std::vector<int> vertex_chunks(start[num_vertices]);
+  std::vector<int> next(start.begin(), start.end() - 1);
+  seen.assign(num_vertices, -1);
+  for (Index c = 0; c < num_chunks; ++c)
+    for_each_chunk_vertex(c, [&](int v) { vertex_chunks[next[v]++] = static_cast<int>(c); });
+
   std::vector<int> chunk_color(num_chunks, -1);
   std::vector<char> used;
+  seen.assign(num_vertices, -1);
   for (Index c = 0; c < num_chunks; ++c) {
     used.assign(num_chunks + 1, 0);
-    for (int i = partition.chunk_begin[c]; i < partition.chunk_begin[c + 1]; ++i)
-      for (int k = 0; k < 4; ++k)
-        for (int other : vertex_chunks[tets(partition.order[i], k)])
-          if (chunk_color[other] >= 0) used[chunk_color[other]] = 1;
+    for_each_chunk_vertex(c, [&](int v) {
+      for (int j = start[v]; j < start[v + 1]; ++j)
+        if (chunk_color[vertex_chunks[j]] >= 0) used[chunk_color[vertex_chunks[j]]] = 1;
+    });
     int color = 0;
     while (used[color])
       ++color;
