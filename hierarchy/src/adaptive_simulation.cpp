@@ -324,10 +324,9 @@ void AdaptiveSimulation::move_to_window(std::size_t w, bool initial) {
       for (NodeId parent : changes.coarsen)
         if (m_cut->is_active(parent)) m_tree->coarsen_subtree(parent);
     } else {
-      const VectorXd x = m_simulation->positions();
-      const VectorXd v = m_simulation->velocities();
-      change_cut(changes, pass, step_count(), x, v, m_simulation->kinetic_energy(),
-                 momentum(*m_simulation), m_simulation->plastic_state());
+      change_cut(changes, pass, step_count(), m_simulation->positions(), m_simulation->velocities(),
+                 m_simulation->kinetic_energy(), momentum(*m_simulation),
+                 m_simulation->plastic_state());
     }
   }
 }
@@ -456,7 +455,8 @@ void AdaptiveSimulation::advance_with_redo() {
     m_report.redo_seconds += attempt;
     // The Simulation is one step ahead: carry the start-of-step state to the new cut and redo
     // the step there (the new cut's start state is the one a further pass starts from).
-    change_cut(changes, pass, step_count() - 1, x0, v0, kinetic0, momentum0, plastic0);
+    change_cut(changes, pass, step_count() - 1, std::move(x0), std::move(v0), kinetic0, momentum0,
+               std::move(plastic0));
     x0 = m_simulation->positions();
     v0 = m_simulation->velocities();
     kinetic0 = m_simulation->kinetic_energy();
@@ -534,17 +534,15 @@ bool AdaptiveSimulation::adapt(int pass, bool refine, bool coarsen) {
     return false;
   }
   m_bookkeeping_seconds += seconds_since(start);
-  const VectorXd x = m_simulation->positions();
-  const VectorXd v = m_simulation->velocities();
-  change_cut(changes, pass, step_count(), x, v, m_simulation->kinetic_energy(),
-             momentum(*m_simulation), m_simulation->plastic_state());
+  change_cut(changes, pass, step_count(), m_simulation->positions(), m_simulation->velocities(),
+             m_simulation->kinetic_energy(), momentum(*m_simulation),
+             m_simulation->plastic_state());
   return true;
 }
 
 void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long first_step,
-                                    const VectorXd& x_mesh, const VectorXd& v_mesh,
-                                    double old_kinetic_energy, const Vector3d& old_momentum,
-                                    const PlasticState& plastic) {
+                                    VectorXd x_mesh, VectorXd v_mesh, double old_kinetic_energy,
+                                    const Vector3d& old_momentum, PlasticState plastic) {
   const auto start = Clock::now();
   const Simulation& sim = *m_simulation;
   CutChangeRecord record;
@@ -558,8 +556,6 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     record.energy_before = old_kinetic_energy + sim.embedded_model().energy(x_q);
   }
   record.momentum_before = old_momentum;
-  const VectorXd old_positions = x_mesh;
-  const VectorXd old_velocities = v_mesh;
   // The cut before the change, restored if the change fails.
   const ActiveCut cut_before = *m_cut;
   const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
@@ -568,42 +564,45 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.refined = counts.refined + counts.balance_refined + full_resolution_refined;
   record.coarsened = counts.coarsened;
 
-  // The new objects are built aside and swapped in only when complete: an exception leaves the
-  // previous Simulation in place and marks the driver failed.
+  // What the change needs of the previous Simulation is taken first; that Simulation is then
+  // released, so that the new one is built in the memory it frees (one Simulation at a time: a
+  // lower peak, and no fresh pages to touch at every change). The state moved is the one passed
+  // in, so nothing else of it is needed.
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
-  std::unique_ptr<Simulation> old_simulation = std::move(m_simulation);
-  VectorXd old_mesh_external = m_mesh_external;
-  VectorXd old_load_traction = m_load_traction;
+  const VectorXd old_dof_vertex_mass = m_simulation->dof_vertex_mass();
+  SimulationCounters old_counters = m_simulation->counters();
+  if (first_step < m_simulation->step_count()) old_counters.steps -= 1;  // a redone step
+  m_finished_counters = add(m_finished_counters, old_counters);
+  m_simulation.reset();
   try {
     rebuild(first_step);
     const FlatTreeMesh& new_flat = m_constrained->flat;
     const HangingConstraints& constraints = m_constrained->constraints;
-    const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, old_positions, new_flat);
-    const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, old_velocities, new_flat);
+    const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, x_mesh, new_flat);
+    const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, v_mesh, new_flat);
     if (!plastic.empty())
       m_simulation->set_plastic_state(transfer_plastic_state(
           *m_tree, old_cut->flat, plastic, new_flat, &record.plastic_merge_change));
     m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
-    keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_simulation->dof_vertex_mass(),
+    keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_dof_vertex_mass,
                         old_kinetic_energy, old_momentum);
     if (!m_obstacles.empty()) record.contact_correction = m_simulation->push_out_of_obstacles();
   } catch (...) {
-    *m_cut = cut_before;
-    m_constrained = std::move(old_cut);
-    m_simulation = std::move(old_simulation);
-    m_mesh_external = std::move(old_mesh_external);
-    m_load_traction = std::move(old_load_traction);
+    // The previous cut comes back with a Simulation rebuilt on it at the state that was being
+    // moved (for the outputs of a failed run); the driver is marked failed.
     m_failed = true;
+    *m_cut = cut_before;
+    m_simulation.reset();
+    rebuild(first_step);
+    if (!plastic.empty()) m_simulation->set_plastic_state(plastic);
+    m_simulation->set_state(m_constrained->constraints.restrict_to_free(x_mesh),
+                            m_constrained->constraints.restrict_to_free(v_mesh));
     throw;
   }
   if (to_full_resolution) {
     m_at_full_resolution = true;
     m_report.full_resolution_step = first_step;
   }
-  SimulationCounters old_counters = old_simulation->counters();
-  if (first_step < old_simulation->step_count()) old_counters.steps -= 1;  // a redone step
-  m_finished_counters = add(m_finished_counters, old_counters);
-  old_simulation.reset();
   old_cut.reset();
   for (NodeId parent : changes.coarsen)
     if (m_cut->is_active(parent)) m_tree->coarsen_subtree(parent);  // memory follows the cut

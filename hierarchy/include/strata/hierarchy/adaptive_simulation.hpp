@@ -246,10 +246,10 @@ class AdaptiveSimulation final : public SimulationRun {
   bool adapt(int pass, bool refine, bool coarsen);
   /// Changes the cut by `changes` and moves the mesh-level state (x, v) of the current cut, with
   /// its kinetic energy, momentum and per-tet plastic state, onto it; the new Simulation starts at
-  /// `first_step`.
-  void change_cut(const CutChanges& changes, int pass, long first_step, const VectorXd& x,
-                  const VectorXd& v, double old_kinetic_energy, const Vector3d& old_momentum,
-                  const PlasticState& plastic);
+  /// `first_step`. The current Simulation is released before the new one is built, so the state
+  /// is taken by value.
+  void change_cut(const CutChanges& changes, int pass, long first_step, VectorXd x, VectorXd v,
+                  double old_kinetic_energy, const Vector3d& old_momentum, PlasticState plastic);
   CutChanges decide(bool refine, bool coarsen);
   void advance_with_redo();
   void initial_adaptation();
