@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <stdexcept>
 
 #include "strata/core/common/error.hpp"
@@ -556,6 +557,13 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     record.energy_before = old_kinetic_energy + sim.embedded_model().energy(x_q);
   }
   record.momentum_before = old_momentum;
+  // What the change needs of the current Simulation, taken before anything changes: that
+  // Simulation is released before the next one is built, so that the new one is built in the
+  // memory it frees (one Simulation at a time: a lower peak, and no fresh pages to touch at every
+  // change). The state moved is the one passed in, so nothing else of it is needed.
+  const VectorXd old_dof_vertex_mass = m_simulation->dof_vertex_mass();
+  SimulationCounters old_counters = m_simulation->counters();
+  if (first_step < m_simulation->step_count()) old_counters.steps -= 1;  // a redone step
   // The cut before the change, restored if the change fails.
   const ActiveCut cut_before = *m_cut;
   const CutChangeCounts counts = m_controller->apply(*m_cut, changes, sim.step_count());
@@ -564,14 +572,7 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.refined = counts.refined + counts.balance_refined + full_resolution_refined;
   record.coarsened = counts.coarsened;
 
-  // What the change needs of the previous Simulation is taken first; that Simulation is then
-  // released, so that the new one is built in the memory it frees (one Simulation at a time: a
-  // lower peak, and no fresh pages to touch at every change). The state moved is the one passed
-  // in, so nothing else of it is needed.
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
-  const VectorXd old_dof_vertex_mass = m_simulation->dof_vertex_mass();
-  SimulationCounters old_counters = m_simulation->counters();
-  if (first_step < m_simulation->step_count()) old_counters.steps -= 1;  // a redone step
   m_finished_counters = add(m_finished_counters, old_counters);
   m_simulation.reset();
   try {
@@ -589,15 +590,22 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     if (!m_obstacles.empty()) record.contact_correction = m_simulation->push_out_of_obstacles();
   } catch (...) {
     // The previous cut comes back with a Simulation rebuilt on it at the state that was being
-    // moved (for the outputs of a failed run); the driver is marked failed.
+    // moved (for the outputs of a failed run); the driver is marked failed and the change's
+    // exception goes on. Should that rebuild fail as well (memory), no Simulation is left and
+    // the accessors say so (std::logic_error).
+    const std::exception_ptr change_error = std::current_exception();
     m_failed = true;
     *m_cut = cut_before;
     m_simulation.reset();
-    rebuild(first_step);
-    if (!plastic.empty()) m_simulation->set_plastic_state(plastic);
-    m_simulation->set_state(m_constrained->constraints.restrict_to_free(x_mesh),
-                            m_constrained->constraints.restrict_to_free(v_mesh));
-    throw;
+    try {
+      rebuild(first_step);
+      if (!plastic.empty()) m_simulation->set_plastic_state(plastic);
+      m_simulation->set_state(m_constrained->constraints.restrict_to_free(x_mesh),
+                              m_constrained->constraints.restrict_to_free(v_mesh));
+    } catch (...) {
+      m_simulation.reset();
+    }
+    std::rethrow_exception(change_error);
   }
   if (to_full_resolution) {
     m_at_full_resolution = true;
@@ -792,7 +800,13 @@ MatrixX3d AdaptiveSimulation::displacements(const std::vector<RootPoint>& points
 }
 
 SimulationCounters AdaptiveSimulation::counters() const {
-  return add(m_finished_counters, m_simulation->counters());
+  return add(m_finished_counters, live().counters());
+}
+
+const Simulation& AdaptiveSimulation::live() const {
+  if (!m_simulation)
+    throw std::logic_error("AdaptiveSimulation: a failed cut change left no Simulation");
+  return *m_simulation;
 }
 
 }  // namespace strata

@@ -191,14 +191,14 @@ class AdaptiveSimulation final : public SimulationRun {
 
   /// One time step (or load step), then the criteria if due. Throws DivergenceError as Simulation.
   void advance() override;
-  bool finished() const override { return m_simulation->finished(); }
+  bool finished() const override { return live().finished(); }
   /// The Simulation on the current cut.
-  const Simulation& current() const override { return *m_simulation; }
-  double time() const { return m_simulation->time(); }
-  long step_count() const { return m_simulation->step_count(); }
+  const Simulation& current() const override { return live(); }
+  double time() const { return live().time(); }
+  long step_count() const { return live().step_count(); }
 
   /// The Simulation on the current cut (mesh = flat().mesh; rebuilt at every cut change).
-  const Simulation& simulation() const { return *m_simulation; }
+  const Simulation& simulation() const { return live(); }
   const TetTree& tree() const { return *m_tree; }
   const ActiveCut& cut() const { return *m_cut; }
   /// The current cut as a mesh, with its tree maps.
@@ -243,6 +243,8 @@ class AdaptiveSimulation final : public SimulationRun {
   SimulationOptions flatten(long first_step);
   /// flatten() and a new Simulation on the cut; m_mesh_external follows.
   void rebuild(long first_step);
+  /// *m_simulation; throws std::logic_error when a failed cut change left none.
+  const Simulation& live() const;
   bool adapt(int pass, bool refine, bool coarsen);
   /// Changes the cut by `changes` and moves the mesh-level state (x, v) of the current cut, with
   /// its kinetic energy, momentum and per-tet plastic state, onto it; the new Simulation starts at
@@ -261,7 +263,9 @@ class AdaptiveSimulation final : public SimulationRun {
   RecoveryEstimate estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
-  bool m_failed = false;  ///< a cut change threw: the cut no longer matches the Simulation
+  /// A cut change threw: the run cannot go on (the Simulation, if any, is the previous cut's,
+  /// rebuilt at the state the change was moving).
+  bool m_failed = false;
   /// The run went on at full resolution (full_resolution_fraction): the cut is every node at the
   /// deepest level and no longer adapts.
   bool m_at_full_resolution = false;
