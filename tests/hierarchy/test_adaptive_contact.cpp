@@ -1,15 +1,19 @@
 // Obstacles on the hierarchy (AdaptiveSimulation, "Contact"): full mode against core on the
 // leaves with the same barrier, a block dropped on a sphere on an adaptive cut stays within the
 // tolerance, fine contact points embedded in a coarse cut carry the body where its vertices do
-// not touch, a sphere sliding over a clamped slab is refined under and released behind, and the
-// push-out of a transferred state.
+// not touch, a sphere sliding over a clamped slab is refined under and released behind, the
+// push-out of a transferred state, and a cut change that fails (the refined cut's rest state is
+// inside an obstacle) leaving the previous cut at the start of the step.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 #include "adaptive_test_utils.hpp"
+#include "strata/core/common/error.hpp"
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/simulation.hpp"
@@ -94,6 +98,40 @@ TEST(AdaptiveContact, BlockDroppedOnASphereStaysWithinTheToleranceOnAnAdaptiveCu
   EXPECT_GT(sim.changes().size(), 0u);  // the impact refined the cut
   for (const CutChangeRecord& change : sim.changes())
     EXPECT_LE(change.contact_correction, 0.1);  // a push-out is a small correction, if any
+}
+
+TEST(AdaptiveContact, AFailedCutChangeLeavesThePreviousCutAtTheStartOfTheStep) {
+  // A block clamped at its top, whose bottom face a sphere pokes through between the corners:
+  // the coarse cut is feasible, but refinement puts the face's centre (a new vertex) inside the
+  // sphere, and the Simulation of the refined cut refuses that rest state. The first step's redo
+  // on the refined cut therefore fails.
+  const TetMesh coarse =
+      box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {1, 1, 1});
+  HierarchySettings settings = error_controlled(1, 1e-6);
+  settings.initial_adaptation = false;
+  SolverSettings solver;
+  solver.dt = 2e-3;
+  solver.duration = 0.02;
+  const std::vector<DirichletSpec> clamp = {
+      testing::fixed_plane("top", Vector3d(0, 0, 0.32), Vector3d::UnitZ())};
+  AdaptiveSimulation sim(coarse, settings, rubber(), clamp, {}, std::nullopt, Vector3d(0, 0, -9.81),
+                         solver, {sphere_obstacle(Vector3d::Zero(), 0.223)});
+  const Index root_tets = sim.cut().size();
+  const VectorXd start = sim.simulation().positions();
+  try {
+    sim.advance();
+    ADD_FAILURE() << "the step on the refined cut did not fail";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("inside the obstacle"), std::string::npos)
+        << error.what();
+  }
+  // The previous cut, with a Simulation at the start of the step that failed.
+  EXPECT_EQ(sim.cut().size(), root_tets);
+  EXPECT_EQ(sim.simulation().mesh().tets.rows(), root_tets);
+  EXPECT_EQ(sim.step_count(), 0);
+  EXPECT_EQ(sim.simulation().positions(), start);
+  EXPECT_TRUE(sim.changes().empty());
+  EXPECT_THROW(sim.advance(), std::logic_error);
 }
 
 TEST(AdaptiveContact, FineContactPointsCarryABlockOnACoarseCut) {
