@@ -3,8 +3,10 @@
 // sum of its terms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "fem_test_utils.hpp"
 #include "problem_test_utils.hpp"
@@ -167,6 +169,49 @@ TEST(EnergyTerms, SumIsTheSumOfItsTerms) {
   SparseMatrixd sum_hessian;
   sum.hessian(f.state, sum_hessian, false);
   EXPECT_LE((sum_hessian - H).norm(), 1e-12 * H.norm());
+}
+
+TEST(EnergyTerms, SumHessianIsBitForBitAZeroFillAndTheTermsAddedInOrder) {
+  // The sum lets one of its first two terms write the Hessian (ElasticTerm::set_hessian) instead
+  // of a zero fill and an add; the values must be exactly those of the plain order.
+  TermFixture f(MaterialModel::neohookean);
+  const double h = 5e-3;
+  RayleighDampingTerm damping(*f.embedded, f.mass, 2.0, 1e-3);
+  damping.set_step(f.model->rest_positions(), h);
+  for (const std::string order : {"IEX", "EIX", "IXE"}) {
+    EnergySum sum(f.embedded->stiffness_pattern());
+    for (const char term : order) {
+      if (term == 'I') sum.emplace<InertiaTerm>(f.mass).set_step(f.model->rest_positions(), h);
+      if (term == 'E') sum.emplace<ElasticTerm>(*f.embedded);
+      if (term == 'X') sum.emplace<ExternalWorkTerm>(f.forces);
+    }
+    SparseMatrixd plain = f.embedded->stiffness_pattern();
+    std::fill(plain.valuePtr(), plain.valuePtr() + plain.nonZeros(), 0.0);
+    for (const auto& term : sum.terms())
+      term->add_hessian(f.state, plain, false);
+    SparseMatrixd summed;
+    sum.hessian(f.state, summed, false);
+    ASSERT_EQ(summed.nonZeros(), plain.nonZeros()) << order;
+    Index different = 0;
+    for (Index k = 0; k < plain.nonZeros(); ++k)
+      different += summed.valuePtr()[k] != plain.valuePtr()[k];
+    EXPECT_EQ(different, 0) << order;
+    // A second evaluation overwrites rather than adds.
+    sum.hessian(f.state, summed, false);
+    EXPECT_TRUE(
+        std::equal(plain.valuePtr(), plain.valuePtr() + plain.nonZeros(), summed.valuePtr()))
+        << order;
+  }
+  // ElasticTerm::set_hessian writes what add_hessian adds to zeros.
+  ElasticTerm elastic(*f.embedded);
+  SparseMatrixd added = f.embedded->stiffness_pattern();
+  std::fill(added.valuePtr(), added.valuePtr() + added.nonZeros(), 0.0);
+  elastic.add_hessian(f.state, added, true);
+  SparseMatrixd set = f.embedded->stiffness_pattern();
+  std::fill(set.valuePtr(), set.valuePtr() + set.nonZeros(), 7.0);  // overwritten
+  ASSERT_TRUE(elastic.set_hessian(f.state, set, true));
+  EXPECT_TRUE(std::equal(added.valuePtr(), added.valuePtr() + added.nonZeros(), set.valuePtr()));
+  EXPECT_FALSE(damping.set_hessian(f.state, set, false));  // a term that only adds
 }
 
 }  // namespace

@@ -17,4 +17,10 @@ void ElasticTerm::add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian,
   add_values_same_pattern(m_stiffness, 1.0, hessian);
 }
 
+bool ElasticTerm::set_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian,
+                              bool project_psd) const {
+  m_model.stiffness(q, hessian, project_psd);
+  return true;
+}
+
 }  // namespace strata

@@ -40,9 +40,14 @@ void EnergySum::gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
 void EnergySum::hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const {
   if (hessian.rows() != m_pattern->rows() || hessian.nonZeros() != m_pattern->nonZeros())
     hessian = *m_pattern;
-  std::fill(hessian.valuePtr(), hessian.valuePtr() + hessian.nonZeros(), 0.0);
-  for (const auto& term : m_terms)
-    term->add_hessian(q, hessian, project_psd);
+  // One of the first two terms writes H if it can; the others add in order.
+  const std::size_t none = m_terms.size();
+  std::size_t setter = none;
+  for (std::size_t i = 0; i < std::min<std::size_t>(2, m_terms.size()) && setter == none; ++i)
+    if (m_terms[i]->set_hessian(q, hessian, project_psd)) setter = i;
+  if (setter == none) std::fill(hessian.valuePtr(), hessian.valuePtr() + hessian.nonZeros(), 0.0);
+  for (std::size_t i = 0; i < m_terms.size(); ++i)
+    if (i != setter) m_terms[i]->add_hessian(q, hessian, project_psd);
 }
 
 void add_values_same_pattern(const SparseMatrixd& source, double scale, SparseMatrixd& target) {

@@ -15,6 +15,8 @@ class ElasticTerm final : public EnergyTerm {
   void add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const override;
   /// Element Hessians ∂²ψ/∂F², PSD-projected per element when asked (isotropic_hessian.hpp).
   void add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const override;
+  /// The model assembles into H directly (its pattern is the Problem's).
+  bool set_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const override;
 
  private:
   const EmbeddedElasticModel& m_model;

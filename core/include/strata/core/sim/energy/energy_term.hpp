@@ -30,6 +30,13 @@ class EnergyTerm {
   /// sum stays PSD). H has the Problem's pattern; only its values change.
   virtual void add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian,
                            bool project_psd) const = 0;
+  /// H = ∂²E/∂q² (or its PSD projection), overwriting every value of H (the Problem's pattern):
+  /// for a term that assembles the whole pattern anyway, which saves the sum a zero fill and an
+  /// add. Returns false (H untouched) where the term only adds.
+  virtual bool set_hessian(ConstRef<VectorXd> /*q*/, SparseMatrixd& /*hessian*/,
+                           bool /*project_psd*/) const {
+    return false;
+  }
   /// The largest α ≤ 1 for which the term is sure to stay finite along q + α Δq (a barrier's
   /// step filter); 1 for terms defined everywhere.
   virtual double max_step(ConstRef<VectorXd> /*q*/, ConstRef<VectorXd> /*step*/) const {
@@ -59,6 +66,9 @@ class EnergySum {
   /// The smallest max_step of the terms.
   double max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const;
   /// ∂²E/∂q² in the pattern (H is set to the pattern on first use, then only its values change).
+  /// The first of the first two terms that can write H does so (set_hessian), else H starts at
+  /// zero; the others add in order. Since 0 + x = x and a + b = b + a, the values are the same
+  /// bit for bit as a zero fill followed by adding every term in order.
   void hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const;
 
  private:
