@@ -12,8 +12,10 @@
 // sizes, which separates the multigrid's dependence on h from the change of the operator: at a
 // fixed 1 ms the 48k box is inertia-dominated (ρh²/(E dt²) ≈ 2.5, h the cell size / 2^L) and the 3M
 // box stiffness-dominated (≈ 0.16), and CG needs more iterations on the stiffer operator at any
-// size. Counters: Newton iterations, CG iterations and multigrid setups per timed step, DOFs,
-// levels, the wall time of all multigrid setups (the warm-up step's included) and of the warm-up
+// size.
+//
+// Counters: Newton iterations, CG iterations and multigrid setups per timed step, DOFs, levels, dt
+// [ms], the wall time of all multigrid setups (the warm-up step's included) and of the warm-up
 // step (first_step_seconds: with CHOLMOD its first factorisation).
 #include <benchmark/benchmark.h>
 
@@ -136,32 +138,25 @@ void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind so
 }
 
 const bool registered = [] {
-  for (int level : {2, 3, 4})
-    for (LinearSolverKind solver : {LinearSolverKind::cholmod, LinearSolverKind::multigrid}) {
-      if (solver == LinearSolverKind::cholmod && level > 3) continue;
-      for (int threads : thread_counts()) {
-        const long long tets = 750LL << (3 * level);
-        const std::string name = "tree_implicit_euler_step/" + to_string(solver) +
-                                 "/tets:" + std::to_string(tets) +
-                                 "/threads:" + std::to_string(threads);
-        benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
-            name.c_str(), tree_step_benchmark, level, solver, threads, 1e-3);
-        b->Unit(benchmark::kMillisecond)->UseRealTime();
-        b->Iterations(level >= 4 ? 2 : level == 3 ? 4 : 10);
-      }
-    }
-  for (int level : {2, 3, 4})
+  // One step benchmark per family, solver, size and thread count.
+  const auto add = [](const std::string& family, LinearSolverKind solver, int level, double dt) {
+    const long long tets = 750LL << (3 * level);
     for (int threads : thread_counts()) {
-      const long long tets = 750LL << (3 * level);
-      const std::string name =
-          "tree_implicit_euler_step_scaled_dt/multigrid/tets:" + std::to_string(tets) +
-          "/threads:" + std::to_string(threads);
+      const std::string name = family + "/" + to_string(solver) + "/tets:" + std::to_string(tets) +
+                               "/threads:" + std::to_string(threads);
       benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
-          name.c_str(), tree_step_benchmark, level, LinearSolverKind::multigrid, threads,
-          1e-3 * (1 << (4 - level)));
+          name.c_str(), tree_step_benchmark, level, solver, threads, dt);
       b->Unit(benchmark::kMillisecond)->UseRealTime();
       b->Iterations(level >= 4 ? 2 : level == 3 ? 4 : 10);
     }
+  };
+  for (int level : {2, 3, 4})
+    for (LinearSolverKind solver : {LinearSolverKind::cholmod, LinearSolverKind::multigrid})
+      if (solver != LinearSolverKind::cholmod || level <= 3)
+        add("tree_implicit_euler_step", solver, level, 1e-3);
+  for (int level : {2, 3, 4})
+    add("tree_implicit_euler_step_scaled_dt", LinearSolverKind::multigrid, level,
+        1e-3 * (1 << (4 - level)));
   return true;
 }();
 

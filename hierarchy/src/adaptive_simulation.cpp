@@ -559,8 +559,8 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.momentum_before = old_momentum;
   // What the change needs of the current Simulation, taken before anything changes: that
   // Simulation is released before the next one is built, so that the new one is built in the
-  // memory it frees (one Simulation at a time: a lower peak, and no fresh pages to touch at every
-  // change). The state moved is the one passed in, so nothing else of it is needed.
+  // memory it frees (one Simulation at a time: a lower peak, and a first change as fast as the
+  // later ones). The state moved is the one passed in, so nothing else of it is needed.
   const VectorXd old_dof_vertex_mass = m_simulation->dof_vertex_mass();
   SimulationCounters old_counters = m_simulation->counters();
   if (first_step < m_simulation->step_count()) old_counters.steps -= 1;  // a redone step
