@@ -104,10 +104,10 @@ struct StvkStiffnessLanes {
   }
 };
 
-/// Prefetches the sparse values that scatter_element_stiffness will update for the kLanes tets
-/// whose offsets start at `offsets`.
+/// Prefetches the sparse values that scatter_element_stiffness will update for the tet whose 48
+/// offsets start at `offsets`.
 inline void prefetch_block_entries(const int* offsets, const double* values) {
-  for (int k = 0; k < 48 * kLanes; ++k)
+  for (int k = 0; k < 48; ++k)
     __builtin_prefetch(values + offsets[k], 1, 3);
 }
 

@@ -75,7 +75,6 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
       m_sorted_tets[4 * i + k] = tets(m_partition.order[i], k);
   });
   fill_rest_arrays();
-  build_stiffness_pattern();
 }
 
 void ElasticModel::fill_rest_arrays() {
@@ -302,7 +301,12 @@ double ElasticModel::energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const 
   return energy;
 }
 
-void ElasticModel::build_stiffness_pattern() {
+const SparseMatrixd& ElasticModel::stiffness_pattern() const {
+  std::call_once(m_pattern_built, [this] { build_stiffness_pattern(); });
+  return m_pattern;
+}
+
+void ElasticModel::build_stiffness_pattern() const {
   const Index num_tets = m_tets.rows();
   // Column 3v + c holds, for each neighbour w of v (ascending), the rows 3w, 3w + 1, 3w + 2.
   const CompressedLists neighbours = vertex_neighbours(m_tets, m_num_vertices);
@@ -355,13 +359,29 @@ void generic_stiffness_blocks(const Matrix9d& d2psi, const Eigen::Matrix<double,
 
 void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const {
   check_size(x, num_dofs());
-  if (K.rows() != m_pattern.rows() || K.nonZeros() != m_pattern.nonZeros() ||
-      !std::equal(m_pattern.outerIndexPtr(), m_pattern.outerIndexPtr() + m_pattern.outerSize() + 1,
+  const SparseMatrixd& pattern = stiffness_pattern();
+  if (K.rows() != pattern.rows() || K.nonZeros() != pattern.nonZeros() ||
+      !std::equal(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.outerSize() + 1,
                   K.outerIndexPtr()))
-    K = m_pattern;
+    K = pattern;
   else
     std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
-  double* values = K.valuePtr();
+  stiffness_into(x, project_psd, {K.valuePtr(), m_block_offsets.data()});
+}
+
+namespace {
+
+/// The value array that tet `tet`'s offsets point into.
+double* scatter_values(const StiffnessScatter& scatter, Index tet) {
+  return scatter.in_second != nullptr && scatter.in_second[tet] ? scatter.second_values
+                                                                : scatter.values;
+}
+
+}  // namespace
+
+void ElasticModel::stiffness_into(ConstRef<VectorXd> x, bool project_psd,
+                                  const StiffnessScatter& scatter) const {
+  check_size(x, num_dofs());
   detail::visit_material_model(m_material.model, [&](auto model_type) {
     using Model = decltype(model_type);
     // A model with a closed-form element stiffness (four tets at a time, and one at a time for a
@@ -384,12 +404,15 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
             // The value array is far larger than the caches: fetch the next group's entries while
             // this group's blocks are computed.
             if (i + 2 * kLanes <= end)
-              detail::prefetch_block_entries(&m_block_offsets[48 * (i + kLanes)], values);
+              for (int l = kLanes; l < 2 * kLanes; ++l)
+                detail::prefetch_block_entries(&scatter.offsets[48 * (i + l)],
+                                               scatter_values(scatter, i + l));
             double F[3][3][kLanes];
             detail::lane_deformation_gradient(x.data(), &m_sorted_tets[4 * i], lane_Dm_inv, F);
             lanes(F, lane_Dm_inv, lane_Dm_inv + 9 * kLanes, lane_K);
             for (int l = 0; l < kLanes; ++l)
-              detail::scatter_element_stiffness(lane_K[l], &m_block_offsets[48 * (i + l)], values);
+              detail::scatter_element_stiffness(lane_K[l], &scatter.offsets[48 * (i + l)],
+                                                scatter_values(scatter, i + l));
           }
         }
       }
@@ -418,7 +441,8 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
           }
           generic_stiffness_blocks(d2psi, grad_N, m_sorted_volume[i], blocks);
         }
-        const int* offsets = &m_block_offsets[48 * i];
+        const int* offsets = &scatter.offsets[48 * i];
+        double* values = scatter_values(scatter, i);
         for (int a = 0; a < 4; ++a)
           for (int b = 0; b < 4; ++b)
             for (int c = 0; c < 3; ++c) {

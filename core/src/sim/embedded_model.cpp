@@ -11,6 +11,7 @@
 
 #include "strata/core/common/compressed_lists.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
 
 namespace strata {
@@ -135,11 +136,13 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
     m_model->stiffness(q, K, project_psd);
     return;
   }
-  m_model->stiffness(expand(q), m_mesh_stiffness, project_psd);
   if (K.nonZeros() != m_pattern.nonZeros() || K.rows() != m_pattern.rows()) K = m_pattern;
   double* values = K.valuePtr();
   std::fill(values, values + K.nonZeros(), 0.0);
-  const double* source = m_mesh_stiffness.valuePtr();
+  m_layer_values.assign(3 * m_block_targets.size(), 0.0);
+  m_model->stiffness_into(expand(q), project_psd,
+                          {values, m_offsets.data(), m_in_layer.data(), m_layer_values.data()});
+  const double* source = m_layer_values.data();
   const WeightedTarget* weighted = m_weighted_targets.data();
   for (const int target : m_block_targets) {
     if (target >= 0) {
@@ -155,12 +158,10 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
 }
 
 void EmbeddedElasticModel::build_reduced_pattern() {
-  // The mesh stiffness is 3×3-block dense: column 3w+j holds rows 3v..3v+2 contiguously for every
-  // neighbour v of w. A block (v, w) feeds the reduced blocks (a, b) for C_va ≠ 0, C_wb ≠ 0 with
-  // weight C_va C_wb, column by column (3 contiguous values each).
-  const SparseMatrixd& mesh_pattern = m_model->stiffness_pattern();
-  const int* mesh_outer = mesh_pattern.outerIndexPtr();
-  const int* mesh_inner = mesh_pattern.innerIndexPtr();
+  // Mesh vertices v, w are neighbours when a tet holds both; an element block (v, w) feeds the
+  // reduced blocks (a, b) for C_va ≠ 0, C_wb ≠ 0 with weight C_va C_wb.
+  const MatrixX4i& tets = m_model->tets();
+  const Index num_mesh_vertices = m_C.rows();
   using RowMajor = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
   const RowMajor C_rows = m_C;
   const int* row_outer = C_rows.outerIndexPtr();
@@ -168,85 +169,141 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   const double* row_values = C_rows.valuePtr();
 
   // Block pattern: the reduced neighbours a of DOF vertex b.
-  const CompressedLists blocks = sorted_unique_lists(
-      m_num_dof_vertices, m_num_dof_vertices, [&](Index b, std::vector<int>& out) {
-        for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
-          for (int k = mesh_outer[3 * w.row()]; k < mesh_outer[3 * w.row() + 1]; k += 3) {
-            const int v = mesh_inner[k] / 3;
-            out.insert(out.end(), row_inner + row_outer[v], row_inner + row_outer[v + 1]);
-          }
-      });
-
+  CompressedLists block_lists;
+  {
+    const CompressedLists neighbours = vertex_neighbours(tets, num_mesh_vertices);
+    block_lists = sorted_unique_lists(
+        m_num_dof_vertices, m_num_dof_vertices, [&](Index b, std::vector<int>& out) {
+          for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
+            for (const int v : neighbours[w.row()])
+              out.insert(out.end(), row_inner + row_outer[v], row_inner + row_outer[v + 1]);
+        });
+  }
+  const CompressedLists& blocks = block_lists;
   m_pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
 
-  // The targets of the mesh blocks, in the order of the mesh values: the columns (w, j), their
-  // blocks v, then the entries C_va, C_wb. A block whose C rows are single entries of weight 1
-  // (no hanging vertex) adds to one reduced block directly.
-  const Index num_mesh_vertices = m_C.rows();
-  auto direct = [&](int row) {
-    return row_outer[row + 1] - row_outer[row] == 1 && row_values[row_outer[row]] == 1.0;
-  };
+  // A mesh vertex whose C row is e_q for its own DOF vertex q is direct. Distinct direct vertices
+  // have distinct DOF vertices, so tets of direct vertices that share no vertex share no target.
+  std::vector<int> direct_dof(num_mesh_vertices, -1);
+  for (Index q = 0; q < m_num_dof_vertices; ++q) {
+    const int v = m_dof_vertices[q];
+    if (row_outer[v + 1] - row_outer[v] == 1 && row_values[row_outer[v]] == 1.0)
+      direct_dof[v] = static_cast<int>(q);
+  }
+
+  // The layer: the tets with a vertex that is not direct, and the blocks of their vertices.
+  const std::vector<int>& sorted_tets = m_model->sorted_tets();
+  const Index num_tets = tets.rows();
+  m_in_layer.resize(num_tets);
+  tbb::parallel_for(Index(0), num_tets, [&](Index t) {
+    const int* tet = &sorted_tets[4 * t];
+    m_in_layer[t] = direct_dof[tet[0]] < 0 || direct_dof[tet[1]] < 0 || direct_dof[tet[2]] < 0 ||
+                    direct_dof[tet[3]] < 0;
+  });
+  m_num_layer_tets = std::count(m_in_layer.begin(), m_in_layer.end(), std::uint8_t(1));
+  MatrixX4i layer_tets(m_num_layer_tets, 4);
+  for (Index t = 0, row = 0; t < num_tets; ++t)
+    if (m_in_layer[t]) {
+      for (int k = 0; k < 4; ++k)
+        layer_tets(row, k) = sorted_tets[4 * t + k];
+      ++row;
+    }
+  const CompressedLists layer = vertex_neighbours(layer_tets, num_mesh_vertices);
+  if (9 * layer.indices.size() > std::size_t(std::numeric_limits<int>::max()))
+    throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
+
+  // Element block offsets: K_q's values for direct tets, the layer's for the others.
+  m_offsets.resize(48 * num_tets);
+  tbb::parallel_for(Index(0), num_tets, [&](Index t) {
+    const int* tet = &sorted_tets[4 * t];
+    int* offsets = &m_offsets[48 * t];
+    const bool in_layer = m_in_layer[t];
+    const CompressedLists& lists = in_layer ? layer : blocks;
+    int index[4];  // the tet's vertices in `lists`' numbering
+    for (int k = 0; k < 4; ++k)
+      index[k] = in_layer ? tet[k] : direct_dof[tet[k]];
+    for (int b = 0; b < 4; ++b) {
+      // The slot of each corner a in b's list: the count of smaller entries.
+      int slot[4] = {0, 0, 0, 0};
+      for (const int entry : lists[index[b]])
+        for (int a = 0; a < 4; ++a)
+          slot[a] += entry < index[a];
+      for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 3; ++c)
+          offsets[12 * a + 3 * b + c] =
+              static_cast<int>(block_column_start(lists, index[b], c) + 3 * slot[a]);
+    }
+  });
+
+  // The targets of the layer's blocks, in the order of its values: the columns (w, j), their
+  // blocks v, then the entries C_va, C_wb. A block of two direct vertices adds to one reduced
+  // block directly.
   std::vector<Index> first_weighted(num_mesh_vertices + 1, 0);
   tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
-    // The three columns of a vertex hold the same blocks (the mesh pattern is 3 × 3 dense).
-    const int column_length = mesh_outer[3 * w + 1] - mesh_outer[3 * w];
-    STRATA_VERIFY(mesh_outer[3 * w + 2] - mesh_outer[3 * w + 1] == column_length &&
-                      mesh_outer[3 * w + 3] - mesh_outer[3 * w + 2] == column_length,
-                  "embedding: the mesh stiffness pattern is not made of 3 × 3 blocks");
     const Index w_entries = row_outer[w + 1] - row_outer[w];
     Index count = 0;
-    for (int k = mesh_outer[3 * w]; k < mesh_outer[3 * w + 1]; k += 3) {
-      const int v = mesh_inner[k] / 3;
-      if (!direct(v) || !direct(static_cast<int>(w)))
+    for (const int v : layer[w])
+      if (direct_dof[v] < 0 || direct_dof[w] < 0)
         count += (row_outer[v + 1] - row_outer[v]) * w_entries;
-    }
     first_weighted[w + 1] = 3 * count;
   });
   for (Index w = 0; w < num_mesh_vertices; ++w)
     first_weighted[w + 1] += first_weighted[w];
-  if (mesh_pattern.nonZeros() / 3 > std::numeric_limits<int>::max() ||
-      first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
+  if (first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
-
-  m_block_targets.resize(mesh_pattern.nonZeros() / 3);
+  m_block_targets.resize(3 * layer.indices.size());
   m_weighted_targets.resize(first_weighted[num_mesh_vertices]);
-  // Per thread, the slot of each block row in the list of a DOF vertex b (for w with C_w = e_b).
+  // Per thread: the slot of each DOF vertex in one list of `blocks` (−1 elsewhere), and the slots
+  // of one vertex's targets.
   tbb::enumerable_thread_specific<std::vector<int>> slots_of(
       [&] { return std::vector<int>(m_num_dof_vertices, -1); });
+  tbb::enumerable_thread_specific<std::vector<Index>> target_slots;
   tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+    const std::span<const int> list = layer[w];
+    if (list.empty()) return;
+    // A DOF vertex b of w's row (the only one unless w hangs) and the slots in its list.
     const bool single = row_outer[w + 1] - row_outer[w] == 1;
-    const bool w_direct = direct(static_cast<int>(w));
     std::vector<int>& slot_of = slots_of.local();
-    if (single) {
-      const std::span<const int> list = blocks[row_inner[row_outer[w]]];
-      for (std::size_t slot = 0; slot < list.size(); ++slot)
-        slot_of[list[slot]] = static_cast<int>(slot);
-    }
-    auto target = [&](int a, int b, int j) {
-      Index slot;
-      if (single) {
-        slot = slot_of[a];
-      } else {
-        const std::span<const int> list = blocks[b];
-        slot = std::lower_bound(list.begin(), list.end(), a) - list.begin();
-      }
-      return static_cast<int>(block_column_start(blocks, b, j) + 3 * slot);
+    const std::span<const int> single_list = blocks[row_inner[row_outer[w]]];
+    if (single)
+      for (std::size_t k = 0; k < single_list.size(); ++k)
+        slot_of[single_list[k]] = static_cast<int>(k);
+    auto slot = [&](int a, int b) -> Index {
+      if (single) return slot_of[a];
+      const std::span<const int> b_list = blocks[b];
+      return std::lower_bound(b_list.begin(), b_list.end(), a) - b_list.begin();
     };
+    // The slots of the targets of every block (v, w), in the order (v, C_va, C_wb).
+    std::vector<Index>& slots = target_slots.local();
+    slots.clear();
+    for (const int v : list)
+      for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
+        for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
+          slots.push_back(slot(row_inner[ia], row_inner[ib]));
+    if (single)
+      for (const int a : single_list)
+        slot_of[a] = -1;
+    // The layer's values are column by column (3w + j), each holding the blocks of `list`.
     Index position = first_weighted[w];
-    for (int j = 0; j < 3; ++j)
-      for (int k = mesh_outer[3 * w + j]; k < mesh_outer[3 * w + j + 1]; k += 3) {
-        const int v = mesh_inner[k] / 3;
-        if (w_direct && direct(v)) {
-          m_block_targets[k / 3] = target(row_inner[row_outer[v]], row_inner[row_outer[w]], j);
+    for (int j = 0; j < 3; ++j) {
+      const Index* next_slot = slots.data();
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const int v = list[k];
+        const Index block = block_column_start(layer, w, j) / 3 + static_cast<Index>(k);
+        if (direct_dof[v] >= 0 && direct_dof[w] >= 0) {
+          m_block_targets[block] =
+              static_cast<int>(block_column_start(blocks, direct_dof[w], j) + 3 * *next_slot++);
           continue;
         }
         const Index first = position;
         for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
           for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
-            m_weighted_targets[position++] = {target(row_inner[ia], row_inner[ib], j),
-                                              row_values[ia] * row_values[ib]};
-        m_block_targets[k / 3] = ~static_cast<int>(position - first);
+            m_weighted_targets[position++] = {
+                static_cast<int>(block_column_start(blocks, row_inner[ib], j) + 3 * *next_slot++),
+                row_values[ia] * row_values[ib]};
+        m_block_targets[block] = ~static_cast<int>(position - first);
       }
+    }
   });
 }
 

@@ -4,8 +4,10 @@
 /// tet mesh, evaluated in parallel (TBB) over rest data precomputed in contiguous arrays.
 ///
 /// Positions are 3·#V vertex-major vectors (see types.hpp). The stiffness matrix has a fixed
-/// sparsity pattern built once; `stiffness` only rewrites its values.
+/// sparsity pattern, built on first use; `stiffness` only rewrites its values.
 #include <atomic>
+#include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -14,6 +16,19 @@
 #include "strata/core/fem/tet_rest_data.hpp"
 
 namespace strata {
+
+/// Where `ElasticModel::stiffness_into` puts each tet's element stiffness. For tet i in the
+/// kernels' order (`sorted_tets()`), `offsets[48 i + 12 a + 3 b + c]` is the position of the entry
+/// (row 3a, column 3b + c) of the element's 12 × 12 matrix for local vertices a, b; rows 3a + 1 and
+/// 3a + 2 follow it. The positions are in `values`, or in `second_values` for the tets with
+/// `in_second[i]` set (`in_second` may be null). Tets that share no vertex must have disjoint
+/// targets: the tets of one colour of the schedule are written concurrently.
+struct StiffnessScatter {
+  double* values = nullptr;
+  const int* offsets = nullptr;
+  const std::uint8_t* in_second = nullptr;
+  double* second_values = nullptr;
+};
 
 /// Per-tet stress and strain measures for output.
 struct TetFields {
@@ -50,8 +65,15 @@ class ElasticModel {
   /// first call and only its values are rewritten afterwards. With `project_psd`, each element's
   /// ∂²ψ/∂F² is projected to PSD first (in closed form, see isotropic_hessian.hpp).
   void stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const;
-  /// The stiffness sparsity pattern (values zero), column-major, 3·#V square.
-  const SparseMatrixd& stiffness_pattern() const { return m_pattern; }
+  /// The stiffness sparsity pattern (values zero), column-major, 3·#V square. Built on the first
+  /// call (thread-safe).
+  const SparseMatrixd& stiffness_pattern() const;
+  /// Adds every tet's element stiffness at x to the targets of `scatter` (see StiffnessScatter),
+  /// on the same parallel schedule and with the same kernels as `stiffness`.
+  void stiffness_into(ConstRef<VectorXd> x, bool project_psd,
+                      const StiffnessScatter& scatter) const;
+  /// The tets in the order of the kernels' schedule, 4 vertex indices each (see StiffnessScatter).
+  const std::vector<int>& sorted_tets() const { return m_sorted_tets; }
 
   /// Smallest J = det F over the tets and the index of that tet (a NaN counts as smallest; ties
   /// go to the smaller index). Parallel.
@@ -75,7 +97,7 @@ class ElasticModel {
   template <typename Kernel>
   void accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x, VectorXd& f, double* energy,
                          std::pair<double, Index>* smallest_volume_ratio) const;
-  void build_stiffness_pattern();
+  void build_stiffness_pattern() const;
   /// Writes the kernels' rest arrays from Dm⁻¹ (and Fₚ⁻¹ if set).
   void fill_rest_arrays();
 
@@ -95,10 +117,11 @@ class ElasticModel {
   static constexpr int kLaneRest = 40;
   std::vector<double> m_lane_rest;
   std::vector<Matrix3d> m_plastic_inverse;  ///< #T in mesh order, or empty
-  SparseMatrixd m_pattern;
+  mutable std::once_flag m_pattern_built;
+  mutable SparseMatrixd m_pattern;
   /// For sorted tet i, vertex pair (a, b) and column c: offset in K's value array of the entry
   /// (3·v_a, 3·v_b + c); rows 3·v_a + 1 and 3·v_a + 2 follow it. 48 per tet.
-  std::vector<int> m_block_offsets;
+  mutable std::vector<int> m_block_offsets;
   mutable std::atomic<long long> m_element_evaluations{0};
 };
 

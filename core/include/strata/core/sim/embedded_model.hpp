@@ -11,16 +11,20 @@
 ///
 /// Reduced quantities are energy-consistent: Ψ_q(q) = Ψ(P q), f_q = Pᵀ f(P q),
 /// K_q = Pᵀ K(P q) P (PSD whenever K is, so PSD-projected element Hessians stay PSD). K_q is
-/// assembled into a fixed pattern computed once: each value of the mesh stiffness is scattered
-/// to the reduced entries it feeds with the weights C_va C_wb, a single pass over a precomputed
-/// term list (no sparse product per Newton iteration).
+/// assembled into a fixed pattern computed once, without the whole mesh-level K: a tet whose four
+/// vertices are DOF vertices (C rows e_q) adds its element stiffness straight to K_q in the mesh
+/// model's parallel pass; the tets that touch a hanging vertex (a thin layer where levels meet)
+/// assemble a mesh-level matrix of their own vertex blocks, each of whose blocks (v, w) then adds
+/// to the reduced blocks (a, b) with weight C_va C_wb in one serial pass. The result does not
+/// depend on the thread count.
 ///
 /// Requirements on C (checked, InputError): every row sums to 1 with non-negative entries
 /// (partition of unity: affine fields and rigid motions are reproduced exactly) and each DOF
 /// vertex q has an identity row (`dof_vertices[q]` is a mesh vertex with C(dof_vertices[q], ·) =
 /// e_q). The rest positions of the DOFs are those of their mesh vertices.
 ///
-/// Not thread-safe: `stiffness` reuses a scratch mesh matrix.
+/// Not thread-safe: `stiffness` reuses a scratch buffer.
+#include <cstdint>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -69,10 +73,12 @@ class EmbeddedElasticModel {
   /// K_q = Pᵀ K(P q) P in the fixed pattern `stiffness_pattern()` (set on first use).
   void stiffness(ConstRef<VectorXd> q, SparseMatrixd& K, bool project_psd) const;
   const SparseMatrixd& stiffness_pattern() const;
+  /// Tets that touch a vertex with a weighted C row (they assemble through the mesh-level layer).
+  Index num_layer_tets() const { return m_num_layer_tets; }
 
  private:
-  /// A contribution to the reduced stiffness through a hanging vertex (or any weight ≠ 1):
-  /// values[target + i] += weight · (the mesh block's value i), i = 0, 1, 2.
+  /// A contribution of a layer block to the reduced stiffness through a hanging vertex (or any
+  /// weight ≠ 1): values[target + i] += weight · (the layer block's value i), i = 0, 1, 2.
   struct WeightedTarget {
     int target;
     double weight;
@@ -89,12 +95,16 @@ class EmbeddedElasticModel {
   SparseMatrixd m_C;
   SparseMatrixd m_CT;  ///< Cᵀ, for reductions
   SparseMatrixd m_pattern;
-  /// Per 3-value block of the mesh stiffness values (value 3g … 3g + 2), in order: the reduced
-  /// value it adds to with weight 1 (≥ 0), or ~n (< 0): it goes to the next n entries of
-  /// m_weighted_targets.
+  /// For each tet in the mesh model's order (ElasticModel::sorted_tets): whether it is in the
+  /// layer, and the 48 offsets of its element blocks in K_q's values or in the layer's.
+  std::vector<std::uint8_t> m_in_layer;
+  std::vector<int> m_offsets;
+  Index m_num_layer_tets = 0;
+  /// Per 3-value column of a layer block (values 3g … 3g + 2), in order: the reduced value it adds
+  /// to with weight 1 (≥ 0), or ~n (< 0): it goes to the next n entries of m_weighted_targets.
   std::vector<int> m_block_targets;
   std::vector<WeightedTarget> m_weighted_targets;
-  mutable SparseMatrixd m_mesh_stiffness;
+  mutable std::vector<double> m_layer_values;  ///< the layer's mesh-level blocks
 };
 
 }  // namespace strata

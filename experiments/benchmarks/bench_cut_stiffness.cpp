@@ -1,0 +1,124 @@
+// The elastic model of an adaptive cut: a 1 × 1 × 1 m box of 8 × 8 × 8 coarse cells (3,072
+// roots, 3 levels) refined to level 3 where a tet comes within 0.25 m of the top face's centre,
+// and graded outwards (level 2 within 0.5 m, level 1 within 0.75 m): levels 0–3 side by side, with
+// hanging vertices where they meet, as a local load leaves a cut. Neo-Hookean, E = 1 MPa, ν = 0.45.
+//   - cut_stiffness/build/threads:<n>: what a cut change spends on the elastic model, the mesh
+//     model (rest data, tet partition) and the reduced one (K_q's pattern and assembly plan) of
+//     the flattened cut;
+//   - cut_stiffness/assemble/<raw|psd>/threads:<n>: one K_q = Pᵀ K P at a deformed state, as a
+//     Newton iteration assembles it.
+// Counters: tets, DOFs (3 · free vertices), hanging vertices, K_q's non-zeros.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include <strata/core/common/parallel.hpp>
+#include <strata/core/fem/elastic_model.hpp>
+#include <strata/core/sim/embedded_model.hpp>
+#include <strata/hierarchy/active_cut.hpp>
+#include <strata/hierarchy/hanging_constraints.hpp>
+
+namespace strata::bench {
+namespace {
+
+struct GradedCut {
+  std::unique_ptr<TetTree> tree;
+  std::unique_ptr<ConstrainedCut> cut;
+  Material material;
+};
+
+const GradedCut& graded_cut() {
+  static const GradedCut graded = [] {
+    GradedCut g;
+    g.tree =
+        std::make_unique<TetTree>(box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {8, 8, 8}), 3);
+    ActiveCut cut = ActiveCut::uniform(*g.tree, 0);
+    const Vector3d load(0.5, 0.5, 1.0);
+    for (int level = 0; level < 3; ++level)
+      for (const NodeId n : cut.sorted_nodes()) {
+        if (g.tree->level(n) != level) continue;
+        const auto corners = g.tree->tet_positions(n);
+        double nearest = 1e300;
+        for (int k = 0; k < 4; ++k)
+          nearest = std::min(nearest, (corners.col(k) - load).norm());
+        if (nearest < 0.75 - 0.25 * level) cut.refine(n);
+      }
+    g.cut = std::make_unique<ConstrainedCut>(flatten_cut(cut));
+    g.material.model = MaterialModel::neohookean;
+    g.material.youngs_modulus = 1e6;
+    g.material.poisson_ratio = 0.45;
+    g.material.density = 1000.0;
+    return g;
+  }();
+  return graded;
+}
+
+void set_cut_counters(benchmark::State& state, const GradedCut& g,
+                      const EmbeddedElasticModel& embedded) {
+  state.counters["tets"] = double(g.cut->flat.mesh.tets.rows());
+  state.counters["dofs"] = double(embedded.num_dofs());
+  state.counters["hanging"] = double(g.cut->constraints.num_hanging());
+  state.counters["nonzeros"] = double(embedded.stiffness_pattern().nonZeros());
+}
+
+void build_benchmark(benchmark::State& state, int threads) {
+  const ThreadLimit limit(threads);
+  const GradedCut& g = graded_cut();
+  const TetMesh& mesh = g.cut->flat.mesh;
+  for (auto _ : state) {
+    const ElasticModel model(mesh.vertices, mesh.tets, g.material);
+    const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
+                                        g.cut->constraints.free_vertices());
+    benchmark::DoNotOptimize(embedded.stiffness_pattern().nonZeros());
+  }
+  const ElasticModel model(mesh.vertices, mesh.tets, g.material);
+  const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
+                                      g.cut->constraints.free_vertices());
+  set_cut_counters(state, g, embedded);
+}
+
+void assemble_benchmark(benchmark::State& state, bool project_psd, int threads) {
+  const ThreadLimit limit(threads);
+  const GradedCut& g = graded_cut();
+  const TetMesh& mesh = g.cut->flat.mesh;
+  const ElasticModel model(mesh.vertices, mesh.tets, g.material);
+  const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
+                                      g.cut->constraints.free_vertices());
+  // A smooth bend of the free vertices: every element strained, none inverted.
+  VectorXd q = embedded.rest_positions();
+  for (Index i = 0; i < embedded.num_dof_vertices(); ++i) {
+    const double x = q[3 * i];
+    q[3 * i + 2] += 0.05 * x * x;
+    q[3 * i + 1] *= 1.0 + 0.02 * q[3 * i + 2];
+  }
+  SparseMatrixd K;
+  embedded.stiffness(q, K, project_psd);  // sets the pattern, outside the timing
+  for (auto _ : state) {
+    embedded.stiffness(q, K, project_psd);
+    benchmark::DoNotOptimize(K.valuePtr());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * model.num_tets());
+  set_cut_counters(state, g, embedded);
+}
+
+const bool registered = [] {
+  for (int threads : {1, 2}) {
+    const std::string suffix = "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(("cut_stiffness/build" + suffix).c_str(), build_benchmark, threads)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    for (bool psd : {false, true})
+      benchmark::RegisterBenchmark(
+          ("cut_stiffness/assemble/" + std::string(psd ? "psd" : "raw") + suffix).c_str(),
+          assemble_benchmark, psd, threads)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  }
+  return true;
+}();
+
+}  // namespace
+}  // namespace strata::bench
