@@ -30,7 +30,8 @@ double tet_normalized_volume(const Vector3d& x0, const Vector3d& x1, const Vecto
       std::max({(x1 - x0).squaredNorm(), (x2 - x0).squaredNorm(), (x3 - x0).squaredNorm(),
                 (x2 - x1).squaredNorm(), (x3 - x1).squaredNorm(), (x3 - x2).squaredNorm()}));
   if (!(longest_edge > 0.0)) return 0.0;
-  return 6.0 * std::sqrt(2.0) * tet_signed_volume(x0, x1, x2, x3) / std::pow(longest_edge, 3);
+  return 6.0 * std::sqrt(2.0) * tet_signed_volume(x0, x1, x2, x3) /
+         (longest_edge * longest_edge * longest_edge);
 }
 
 void validate_tet_mesh(const TetMesh& mesh, const std::string& source) {

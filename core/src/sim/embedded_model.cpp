@@ -11,7 +11,6 @@
 
 #include "strata/core/common/compressed_lists.hpp"
 #include "strata/core/common/error.hpp"
-#include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
 
 namespace strata {
@@ -168,10 +167,27 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   const int* row_inner = C_rows.innerIndexPtr();
   const double* row_values = C_rows.valuePtr();
 
+  // The tets of each mesh vertex, in the mesh model's order (ElasticModel::sorted_tets).
+  const std::vector<int>& sorted_tets = m_model->sorted_tets();
+  const Index num_tets = tets.rows();
+  CompressedLists incident;
+  {
+    CompressedLists tet_lists;
+    tet_lists.offsets.resize(num_tets + 1);
+    for (Index t = 0; t <= num_tets; ++t)
+      tet_lists.offsets[t] = 4 * t;
+    tet_lists.indices = sorted_tets;
+    incident = transpose_lists(tet_lists, num_mesh_vertices);
+  }
+
   // Block pattern: the reduced neighbours a of DOF vertex b.
   CompressedLists block_lists;
   {
-    const CompressedLists neighbours = vertex_neighbours(tets, num_mesh_vertices);
+    const CompressedLists neighbours = sorted_unique_lists(
+        num_mesh_vertices, num_mesh_vertices, [&](Index w, std::vector<int>& out) {
+          for (const int t : incident[w])
+            out.insert(out.end(), &sorted_tets[4 * t], &sorted_tets[4 * t] + 4);
+        });
     block_lists = sorted_unique_lists(
         m_num_dof_vertices, m_num_dof_vertices, [&](Index b, std::vector<int>& out) {
           for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
@@ -192,8 +208,6 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   }
 
   // The layer: the tets with a vertex that is not direct, and the blocks of their vertices.
-  const std::vector<int>& sorted_tets = m_model->sorted_tets();
-  const Index num_tets = tets.rows();
   m_in_layer.resize(num_tets);
   tbb::parallel_for(Index(0), num_tets, [&](Index t) {
     const int* tet = &sorted_tets[4 * t];
@@ -201,38 +215,50 @@ void EmbeddedElasticModel::build_reduced_pattern() {
                     direct_dof[tet[3]] < 0;
   });
   m_num_layer_tets = std::count(m_in_layer.begin(), m_in_layer.end(), std::uint8_t(1));
-  MatrixX4i layer_tets(m_num_layer_tets, 4);
-  for (Index t = 0, row = 0; t < num_tets; ++t)
-    if (m_in_layer[t]) {
-      for (int k = 0; k < 4; ++k)
-        layer_tets(row, k) = sorted_tets[4 * t + k];
-      ++row;
-    }
-  const CompressedLists layer = vertex_neighbours(layer_tets, num_mesh_vertices);
+  const CompressedLists layer = sorted_unique_lists(
+      num_mesh_vertices, num_mesh_vertices, [&](Index w, std::vector<int>& out) {
+        for (const int t : incident[w])
+          if (m_in_layer[t]) out.insert(out.end(), &sorted_tets[4 * t], &sorted_tets[4 * t] + 4);
+      });
   if (9 * layer.indices.size() > std::size_t(std::numeric_limits<int>::max()))
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
 
-  // Element block offsets: K_q's values for direct tets, the layer's for the others.
+  // Element block offsets, vertex by vertex: for each tet of w (local corner b), the blocks (a, b)
+  // of its corners a in K_q's values (a direct tet: w's DOF vertex's list) or in the layer's (w's
+  // layer list). The threads write disjoint entries (one corner of a tet each).
   m_offsets.resize(48 * num_tets);
-  tbb::parallel_for(Index(0), num_tets, [&](Index t) {
-    const int* tet = &sorted_tets[4 * t];
-    int* offsets = &m_offsets[48 * t];
-    const bool in_layer = m_in_layer[t];
-    const CompressedLists& lists = in_layer ? layer : blocks;
-    int index[4];  // the tet's vertices in `lists`' numbering
-    for (int k = 0; k < 4; ++k)
-      index[k] = in_layer ? tet[k] : direct_dof[tet[k]];
-    for (int b = 0; b < 4; ++b) {
-      // The slot of each corner a in b's list: the count of smaller entries.
-      int slot[4] = {0, 0, 0, 0};
-      for (const int entry : lists[index[b]])
-        for (int a = 0; a < 4; ++a)
-          slot[a] += entry < index[a];
-      for (int a = 0; a < 4; ++a)
+  tbb::enumerable_thread_specific<std::vector<int>> layer_slots(
+      [&] { return std::vector<int>(num_mesh_vertices, -1); });
+  tbb::enumerable_thread_specific<std::vector<int>> dof_slots(
+      [&] { return std::vector<int>(m_num_dof_vertices, -1); });
+  tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+    std::vector<int>& layer_slot = layer_slots.local();
+    std::vector<int>& dof_slot = dof_slots.local();
+    const std::span<const int> layer_list = layer[w];
+    for (std::size_t k = 0; k < layer_list.size(); ++k)
+      layer_slot[layer_list[k]] = static_cast<int>(k);
+    const int b_dof = direct_dof[w];
+    const std::span<const int> dof_list = b_dof >= 0 ? blocks[b_dof] : std::span<const int>();
+    for (std::size_t k = 0; k < dof_list.size(); ++k)
+      dof_slot[dof_list[k]] = static_cast<int>(k);
+    for (const int t : incident[w]) {
+      const int* tet = &sorted_tets[4 * t];
+      const int b = static_cast<int>(std::find(tet, tet + 4, static_cast<int>(w)) - tet);
+      int* offsets = &m_offsets[48 * Index(t)];
+      for (int a = 0; a < 4; ++a) {
+        const Index start =
+            m_in_layer[t] ? block_column_start(layer, w, 0) + 3 * layer_slot[tet[a]]
+                          : block_column_start(blocks, b_dof, 0) + 3 * dof_slot[direct_dof[tet[a]]];
+        const Index column_length =
+            m_in_layer[t] ? 3 * layer.list_size(w) : 3 * blocks.list_size(b_dof);
         for (int c = 0; c < 3; ++c)
-          offsets[12 * a + 3 * b + c] =
-              static_cast<int>(block_column_start(lists, index[b], c) + 3 * slot[a]);
+          offsets[12 * a + 3 * b + c] = static_cast<int>(start + c * column_length);
+      }
     }
+    for (const int v : layer_list)
+      layer_slot[v] = -1;
+    for (const int q : dof_list)
+      dof_slot[q] = -1;
   });
 
   // The targets of the layer's blocks, in the order of its values: the columns (w, j), their
