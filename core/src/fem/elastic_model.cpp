@@ -1,6 +1,7 @@
 #include "strata/core/fem/elastic_model.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/collaborative_call_once.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -65,7 +66,8 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
       m_material(material),
       m_lame(material.lame()),
       m_rest(compute_tet_rest_data(rest_positions, tets)),
-      m_rest_positions(flatten(rest_positions)) {
+      m_rest_positions(flatten(rest_positions)),
+      m_pattern_once(std::make_unique<PatternOnce>()) {
   validate_material(material, "material");
   m_partition = build_tet_partition(rest_positions, tets);
   const Index num_tets = tets.rows();
@@ -301,8 +303,16 @@ double ElasticModel::energy_and_forces(ConstRef<VectorXd> x, VectorXd& f) const 
   return energy;
 }
 
+/// Collaborative: a thread that waits for the pattern joins the TBB work that builds it, so a
+/// first call from inside a TBB task cannot deadlock.
+struct ElasticModel::PatternOnce {
+  tbb::collaborative_once_flag flag;
+};
+
+ElasticModel::~ElasticModel() = default;
+
 const SparseMatrixd& ElasticModel::stiffness_pattern() const {
-  std::call_once(m_pattern_built, [this] { build_stiffness_pattern(); });
+  tbb::collaborative_call_once(m_pattern_once->flag, [this] { build_stiffness_pattern(); });
   return m_pattern;
 }
 
@@ -405,13 +415,13 @@ void ElasticModel::stiffness_into(ConstRef<VectorXd> x, bool project_psd,
             // this group's blocks are computed.
             if (i + 2 * kLanes <= end)
               for (int l = kLanes; l < 2 * kLanes; ++l)
-                detail::prefetch_block_entries(&scatter.offsets[48 * (i + l)],
+                detail::prefetch_block_entries(&scatter.offsets[48 * Index(i + l)],
                                                scatter_values(scatter, i + l));
             double F[3][3][kLanes];
             detail::lane_deformation_gradient(x.data(), &m_sorted_tets[4 * i], lane_Dm_inv, F);
             lanes(F, lane_Dm_inv, lane_Dm_inv + 9 * kLanes, lane_K);
             for (int l = 0; l < kLanes; ++l)
-              detail::scatter_element_stiffness(lane_K[l], &scatter.offsets[48 * (i + l)],
+              detail::scatter_element_stiffness(lane_K[l], &scatter.offsets[48 * Index(i + l)],
                                                 scatter_values(scatter, i + l));
           }
         }
@@ -441,7 +451,7 @@ void ElasticModel::stiffness_into(ConstRef<VectorXd> x, bool project_psd,
           }
           generic_stiffness_blocks(d2psi, grad_N, m_sorted_volume[i], blocks);
         }
-        const int* offsets = &scatter.offsets[48 * i];
+        const int* offsets = &scatter.offsets[48 * Index(i)];
         double* values = scatter_values(scatter, i);
         for (int a = 0; a < 4; ++a)
           for (int b = 0; b < 4; ++b)

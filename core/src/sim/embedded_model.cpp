@@ -135,7 +135,10 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
     m_model->stiffness(q, K, project_psd);
     return;
   }
-  if (K.nonZeros() != m_pattern.nonZeros() || K.rows() != m_pattern.rows()) K = m_pattern;
+  if (K.rows() != m_pattern.rows() || K.nonZeros() != m_pattern.nonZeros() ||
+      !std::equal(m_pattern.outerIndexPtr(), m_pattern.outerIndexPtr() + m_pattern.outerSize() + 1,
+                  K.outerIndexPtr()))
+    K = m_pattern;
   double* values = K.valuePtr();
   std::fill(values, values + K.nonZeros(), 0.0);
   m_layer_values.assign(3 * m_block_targets.size(), 0.0);

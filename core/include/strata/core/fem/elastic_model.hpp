@@ -7,7 +7,7 @@
 /// sparsity pattern, built on first use; `stiffness` only rewrites its values.
 #include <atomic>
 #include <cstdint>
-#include <mutex>
+#include <memory>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -42,6 +42,7 @@ class ElasticModel {
   /// `tets` must be positively oriented and non-degenerate (throws InputError otherwise).
   ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4i> tets,
                const Material& material);
+  ~ElasticModel();
 
   Index num_vertices() const { return m_num_vertices; }
   Index num_tets() const { return m_tets.rows(); }
@@ -66,7 +67,7 @@ class ElasticModel {
   /// ∂²ψ/∂F² is projected to PSD first (in closed form, see isotropic_hessian.hpp).
   void stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool project_psd) const;
   /// The stiffness sparsity pattern (values zero), column-major, 3·#V square. Built on the first
-  /// call (thread-safe).
+  /// call (thread-safe, also from inside TBB tasks).
   const SparseMatrixd& stiffness_pattern() const;
   /// Adds every tet's element stiffness at x to the targets of `scatter` (see StiffnessScatter),
   /// on the same parallel schedule and with the same kernels as `stiffness`.
@@ -117,7 +118,8 @@ class ElasticModel {
   static constexpr int kLaneRest = 40;
   std::vector<double> m_lane_rest;
   std::vector<Matrix3d> m_plastic_inverse;  ///< #T in mesh order, or empty
-  mutable std::once_flag m_pattern_built;
+  struct PatternOnce;  ///< the once-flag of the pattern's construction (TBB-aware)
+  std::unique_ptr<PatternOnce> m_pattern_once;
   mutable SparseMatrixd m_pattern;
   /// For sorted tet i, vertex pair (a, b) and column c: offset in K's value array of the entry
   /// (3·v_a, 3·v_b + c); rows 3·v_a + 1 and 3·v_a + 2 follow it. 48 per tet.
