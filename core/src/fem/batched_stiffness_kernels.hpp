@@ -1,11 +1,57 @@
 #pragma once
-// Internal to elastic_model.cpp: the StVK element stiffness in closed form, of one tet and of
+// Internal to elastic_model.cpp: element stiffnesses in closed form — StVK of one tet and of
 // kLanes tets at once in structure-of-arrays form (vectorised across tets, like
-// batched_stress_kernels.hpp), and its scatter into the values of the fixed sparsity pattern.
+// batched_stress_kernels.hpp), stable neo-Hookean of one tet — and their scatter into the values
+// of the fixed sparsity pattern.
 #include "batched_stress_kernels.hpp"
+#include "strata/core/fem/neohookean.hpp"
 #include "strata/core/fem/stvk.hpp"
 
 namespace strata::detail {
+
+/// Stable neo-Hookean element stiffness in closed form. Its ∂²ψ/∂F² (neohookean.cpp) is
+/// c₁ I + c₂ f fᵀ + λ g gᵀ + λ(J − α) ∂²J/∂F² with f = vec F, g = vec cof F, c₁ = μ(1 − 1/(I_C +
+/// 1)), c₂ = 2μ/(I_C + 1)² (the model's μ, λ, α); contracted with g_a = ∇N_a, g_b = ∇N_b, block (a,
+/// b) = ∂²W/∂x_a∂x_b is V [c₁ (g_a · g_b) I + c₂ (F g_a)(F g_b)ᵀ + λ (cof F g_a)(cof F g_b)ᵀ
+/// + λ(J − α) E(F (g_a × g_b))], E(v)_qr = ε_qrk v_k (∂²J/∂F_qc∂F_rd = ε_qrk ε_cdl F_kl).
+inline void neohookean_stiffness_blocks(const Matrix3d& F,
+                                        const Eigen::Matrix<double, 4, 3>& grad_N,
+                                        const LameParameters& lame, double volume,
+                                        Matrix3d (&blocks)[4][4]) {
+  const NeoHookeanConstants k = neohookean_constants(lame);
+  const double Ic = F.squaredNorm();
+  const Matrix3d G = cofactor_matrix(F);
+  const double J = F.col(0).dot(G.col(0));
+  const double c1 = volume * k.mu * (1.0 - 1.0 / (Ic + 1.0));
+  const double c2 = volume * 2.0 * k.mu / ((Ic + 1.0) * (Ic + 1.0));
+  const double c3 = volume * k.lambda;
+  const double c4 = volume * k.lambda * (J - k.alpha);
+  double g[4][3], Fg[4][3], Gg[4][3];
+  for (int a = 0; a < 4; ++a)
+    for (int r = 0; r < 3; ++r) {
+      g[a][r] = grad_N(a, r);
+      Fg[a][r] = F(r, 0) * grad_N(a, 0) + F(r, 1) * grad_N(a, 1) + F(r, 2) * grad_N(a, 2);
+      Gg[a][r] = G(r, 0) * grad_N(a, 0) + G(r, 1) * grad_N(a, 1) + G(r, 2) * grad_N(a, 2);
+    }
+  for (int a = 0; a < 4; ++a)
+    for (int b = a; b < 4; ++b) {
+      const double gg = c1 * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+      const double n[3] = {g[a][1] * g[b][2] - g[a][2] * g[b][1],
+                           g[a][2] * g[b][0] - g[a][0] * g[b][2],
+                           g[a][0] * g[b][1] - g[a][1] * g[b][0]};
+      double v[3];
+      for (int r = 0; r < 3; ++r)
+        v[r] = c4 * (F(r, 0) * n[0] + F(r, 1) * n[1] + F(r, 2) * n[2]);
+      const double E[3][3] = {{0.0, v[2], -v[1]}, {-v[2], 0.0, v[0]}, {v[1], -v[0], 0.0}};
+      for (int q = 0; q < 3; ++q)
+        for (int r = 0; r < 3; ++r) {
+          const double value =
+              c2 * Fg[a][q] * Fg[b][r] + c3 * Gg[a][q] * Gg[b][r] + E[q][r] + (q == r ? gg : 0.0);
+          blocks[a][b](q, r) = value;
+          blocks[b][a](r, q) = value;
+        }
+    }
+}
 
 /// StVK element stiffness in closed form, block (b, a) = ∂²W/∂x_b∂x_a:
 /// V [(g_aᵀ S g_b) I + λ (F g_b)(F g_a)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_a)(F g_b)ᵀ], g_k = ∇N_k.

@@ -394,17 +394,21 @@ void ElasticModel::stiffness_into(ConstRef<VectorXd> x, bool project_psd,
   check_size(x, num_dofs());
   detail::visit_material_model(m_material.model, [&](auto model_type) {
     using Model = decltype(model_type);
-    // A model with a closed-form element stiffness (four tets at a time, and one at a time for a
-    // chunk's last tets) uses it for the exact Hessian; otherwise ∂²ψ/∂F² goes through the generic
-    // block product, projected in the singular-value frame when asked.
+    // A model with a closed-form element stiffness (four tets at a time where it has a lane
+    // kernel, one at a time otherwise and for a chunk's last tets) uses it for the exact Hessian;
+    // otherwise ∂²ψ/∂F² goes through the generic block product, projected in the singular-value
+    // frame when asked.
     constexpr bool kClosedForm = requires {
+      Model::stiffness_blocks;
+    };
+    constexpr bool kClosedFormLanes = requires {
       typename Model::StiffnessLaneKernel;
     };
     const bool closed_form = kClosedForm && !project_psd;
     for_each_chunk_colored(m_partition, [&](int chunk) {
       int i = m_partition.chunk_begin[chunk];
       const int end = m_partition.chunk_begin[chunk + 1];
-      if constexpr (kClosedForm) {
+      if constexpr (kClosedFormLanes) {
         if (closed_form) {
           using detail::kLanes;
           const typename Model::StiffnessLaneKernel lanes(m_lame);

@@ -2,8 +2,9 @@
 // The constitutive models as types, one per registry entry (material_registry.hpp). The
 // mesh-level loops visit the type of a run's model once and inline its functions in the element
 // loop. Optional members: a `LaneKernel` runs forces four tets at a time
-// (batched_stress_kernels.hpp); a `StiffnessLaneKernel` with `stiffness_blocks` gives the exact
-// element stiffness in closed form (batched_stiffness_kernels.hpp), four tets and one at a time.
+// (batched_stress_kernels.hpp); `stiffness_blocks` gives the exact element stiffness of one tet in
+// closed form, and a `StiffnessLaneKernel` that of four tets at a time
+// (batched_stiffness_kernels.hpp).
 #include <stdexcept>
 #include <string>
 
@@ -54,6 +55,7 @@ struct NeoHookeanModel {
       "handles inversion";
   static constexpr bool handles_inversion = true;
   using LaneKernel = NeoHookeanLanes;
+  static constexpr auto* stiffness_blocks = &neohookean_stiffness_blocks;
   static constexpr auto* energy_density = &psi_neohookean;
   static constexpr auto* first_piola = &dpsi_neohookean_dF;
   static constexpr auto* hessian = &d2psi_neohookean_dF2;
