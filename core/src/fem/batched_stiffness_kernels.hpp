@@ -1,8 +1,8 @@
 #pragma once
-// Internal to elastic_model.cpp: element stiffnesses in closed form — StVK of one tet and of
-// kLanes tets at once in structure-of-arrays form (vectorised across tets, like
-// batched_stress_kernels.hpp), stable neo-Hookean of one tet — and their scatter into the values
-// of the fixed sparsity pattern.
+// Internal to elastic_model.cpp: element stiffnesses in closed form — StVK and stable
+// neo-Hookean, of one tet and of kLanes tets at once in structure-of-arrays form (vectorised
+// across tets, like batched_stress_kernels.hpp) — and their scatter into the values of the fixed
+// sparsity pattern.
 #include "batched_stress_kernels.hpp"
 #include "strata/core/fem/neohookean.hpp"
 #include "strata/core/fem/stvk.hpp"
@@ -144,6 +144,75 @@ struct StvkStiffnessLanes {
             for (int l = 0; l < kLanes; ++l) {
               K[l][3 * b + c][3 * a + r] = value[l];
               if (a != b) K[l][3 * a + r][3 * b + c] = value[l];
+            }
+          }
+      }
+  }
+};
+
+/// Stable neo-Hookean element stiffness of each lane l, in the layout of StvkStiffnessLanes:
+/// neohookean_stiffness_blocks four tets at a time.
+struct NeoHookeanStiffnessLanes {
+  NeoHookeanConstants k;
+  explicit NeoHookeanStiffnessLanes(const LameParameters& lame) : k(neohookean_constants(lame)) {}
+
+  void operator()(const double (&lane_F)[3][3][kLanes], const double* lane_Dm_inv,
+                  const double* lane_volume, double (&K)[kLanes][12][12]) const {
+    const Vec volume = load_vec(lane_volume);
+    Vec F[3][3], g[4][3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        F[r][c] = load_vec(lane_F[r][c]);
+    for (int a = 1; a < 4; ++a)
+      for (int d = 0; d < 3; ++d)
+        g[a][d] = load_vec(lane_Dm_inv + (3 * d + a - 1) * kLanes);
+    for (int d = 0; d < 3; ++d)
+      g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
+    // cof F, column by column: F₁ × F₂, F₂ × F₀, F₀ × F₁ (Fⱼ the columns of F).
+    Vec G[3][3];
+    for (int c = 0; c < 3; ++c) {
+      const int i = (c + 1) % 3, j = (c + 2) % 3;
+      G[0][c] = F[1][i] * F[2][j] - F[2][i] * F[1][j];
+      G[1][c] = F[2][i] * F[0][j] - F[0][i] * F[2][j];
+      G[2][c] = F[0][i] * F[1][j] - F[1][i] * F[0][j];
+    }
+    Vec Ic{}, J{};
+    for (int r = 0; r < 3; ++r) {
+      J += F[r][0] * G[r][0];
+      for (int c = 0; c < 3; ++c)
+        Ic += F[r][c] * F[r][c];
+    }
+    const Vec inverse = 1.0 / (Ic + 1.0);
+    const Vec c1 = volume * k.mu * (1.0 - inverse);
+    const Vec c2 = volume * (2.0 * k.mu) * inverse * inverse;
+    const Vec c3 = volume * k.lambda;
+    const Vec c4 = volume * k.lambda * (J - k.alpha);
+    Vec Fg[4][3], Gg[4][3], c2Fg[4][3], c3Gg[4][3];
+    for (int a = 0; a < 4; ++a)
+      for (int r = 0; r < 3; ++r) {
+        Fg[a][r] = F[r][0] * g[a][0] + F[r][1] * g[a][1] + F[r][2] * g[a][2];
+        Gg[a][r] = G[r][0] * g[a][0] + G[r][1] * g[a][1] + G[r][2] * g[a][2];
+        c2Fg[a][r] = c2 * Fg[a][r];
+        c3Gg[a][r] = c3 * Gg[a][r];
+      }
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b <= a; ++b) {
+        const Vec gg = c1 * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]);
+        const Vec n[3] = {g[a][1] * g[b][2] - g[a][2] * g[b][1],
+                          g[a][2] * g[b][0] - g[a][0] * g[b][2],
+                          g[a][0] * g[b][1] - g[a][1] * g[b][0]};
+        Vec v[3];
+        for (int r = 0; r < 3; ++r)
+          v[r] = c4 * (F[r][0] * n[0] + F[r][1] * n[1] + F[r][2] * n[2]);
+        const Vec E[3][3] = {{Vec{}, v[2], -v[1]}, {-v[2], Vec{}, v[0]}, {v[1], -v[0], Vec{}}};
+        for (int q = 0; q < 3; ++q)
+          for (int r = 0; r < 3; ++r) {
+            // Block (a, b), row q, column r: row 3a + q, column 3b + r.
+            Vec value = c2Fg[a][q] * Fg[b][r] + c3Gg[a][q] * Gg[b][r] + E[q][r];
+            if (q == r) value += gg;
+            for (int l = 0; l < kLanes; ++l) {
+              K[l][3 * b + r][3 * a + q] = value[l];
+              if (a != b) K[l][3 * a + q][3 * b + r] = value[l];
             }
           }
       }

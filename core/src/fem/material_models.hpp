@@ -55,6 +55,7 @@ struct NeoHookeanModel {
       "handles inversion";
   static constexpr bool handles_inversion = true;
   using LaneKernel = NeoHookeanLanes;
+  using StiffnessLaneKernel = NeoHookeanStiffnessLanes;
   static constexpr auto* stiffness_blocks = &neohookean_stiffness_blocks;
   static constexpr auto* energy_density = &psi_neohookean;
   static constexpr auto* first_piola = &dpsi_neohookean_dF;
