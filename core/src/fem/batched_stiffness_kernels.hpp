@@ -87,6 +87,20 @@ inline void stvk_stiffness_blocks(const Matrix3d& F, const Eigen::Matrix<double,
     }
 }
 
+/// The lanes' F and shape-function gradients g_k = ∇N_k (g_k = row k − 1 of Dm⁻¹ for k ≥ 1,
+/// g_0 = −g_1 − g_2 − g_3), `lane_Dm_inv` in the layout of lane_deformation_gradient.
+inline void load_lane_element(const double (&lane_F)[3][3][kLanes], const double* lane_Dm_inv,
+                              Vec (&F)[3][3], Vec (&g)[4][3]) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      F[r][c] = load_vec(lane_F[r][c]);
+  for (int k = 1; k < 4; ++k)
+    for (int d = 0; d < 3; ++d)
+      g[k][d] = load_vec(lane_Dm_inv + (3 * d + k - 1) * kLanes);
+  for (int d = 0; d < 3; ++d)
+    g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
+}
+
 /// StVK element stiffness of each lane l, 12 × 12 column-major: K[l][3b + c][3a + r] = K_ab(r, c),
 /// K_ab = V [(g_aᵀ S g_b) I + λ (F g_a)(F g_b)ᵀ + μ (g_a · g_b) F Fᵀ + μ (F g_b)(F g_a)ᵀ],
 /// g_k = ∇N_k (g_k = row k − 1 of Dm⁻¹ for k ≥ 1, g_0 = −g_1 − g_2 − g_3), S the second Piola
@@ -99,14 +113,7 @@ struct StvkStiffnessLanes {
                   const double* lane_volume, double (&K)[kLanes][12][12]) const {
     const Vec volume = load_vec(lane_volume);
     Vec F[3][3], g[4][3];
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        F[r][c] = load_vec(lane_F[r][c]);
-    for (int k = 1; k < 4; ++k)
-      for (int d = 0; d < 3; ++d)
-        g[k][d] = load_vec(lane_Dm_inv + (3 * d + k - 1) * kLanes);
-    for (int d = 0; d < 3; ++d)
-      g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
+    load_lane_element(lane_F, lane_Dm_inv, F, g);
 
     Vec E[3][3];
     for (int a = 0; a < 3; ++a)
@@ -160,14 +167,7 @@ struct NeoHookeanStiffnessLanes {
                   const double* lane_volume, double (&K)[kLanes][12][12]) const {
     const Vec volume = load_vec(lane_volume);
     Vec F[3][3], g[4][3];
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        F[r][c] = load_vec(lane_F[r][c]);
-    for (int a = 1; a < 4; ++a)
-      for (int d = 0; d < 3; ++d)
-        g[a][d] = load_vec(lane_Dm_inv + (3 * d + a - 1) * kLanes);
-    for (int d = 0; d < 3; ++d)
-      g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
+    load_lane_element(lane_F, lane_Dm_inv, F, g);
     // cof F, column by column: F₁ × F₂, F₂ × F₀, F₀ × F₁ (Fⱼ the columns of F).
     Vec G[3][3];
     for (int c = 0; c < 3; ++c) {
