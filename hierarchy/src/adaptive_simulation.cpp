@@ -750,6 +750,8 @@ void AdaptiveSimulation::record_sample() {
     const RecoveryEstimate estimate = estimate_error();
     sample.estimated_error = estimate.relative_error;
     sample.estimated_energy_error = estimate.relative_energy_error;
+    sample.estimated_upper_error = estimate.upper_error;
+    sample.estimated_load_work_error = estimate.load_work_error;
   }
   if (!m_history.empty()) {  // accepted steps (the initial sample is the cut before any step)
     m_report.max_estimated_error = std::max(m_report.max_estimated_error, sample.estimated_error);

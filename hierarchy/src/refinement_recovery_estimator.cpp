@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -20,7 +21,24 @@ double twice_energy_density(const Vector6d& e, const LameParameters& lame) {
 /// The share of a level-ℓ tet's energy-norm error that refinement to the finest level L removes,
 /// in the measure of displacements: (1 − 2^−(L−ℓ)) · (h_ℓ / h_0)^½ (see the header).
 double displacement_share_removed(int depth, int level) {
-  return (1.0 - std::pow(2.0, -(depth - level))) * std::pow(2.0, -0.5 * level);
+  return (1.0 - std::ldexp(1.0, -(depth - level))) * std::pow(2.0, -0.5 * level);
+}
+
+/// The share of a level-ℓ tet's squared energy-norm error that lies between it and the finest
+/// level L, 1 − 4^−(L−ℓ) (Galerkin orthogonality; the error energy falls by 4 per level).
+double energy_share_removed(int depth, int level) {
+  return 1.0 - std::ldexp(1.0, -2 * (depth - level));
+}
+
+/// The tolerance on the upper estimate z that the run's tolerance τ on e = √(z c) means. Under
+/// refinement c falls about as z² (c / z² = Σ_t η_t² (1 − 4^−(L−ℓ)) / Σ_t η_t,full² depends only
+/// on the levels of the tets), so with k = c / z² of this state, e ≤ τ ⟺ k z³ ≤ τ²:
+/// τ_z = (τ² z² / c)^⅓ (= z when e = τ).
+double upper_tolerance(const RecoveryEstimate& estimate, double tolerance) {
+  if (estimate.upper_only) return tolerance;
+  if (estimate.load_work_error <= 0.0) return std::numeric_limits<double>::infinity();
+  return std::cbrt(tolerance * tolerance * estimate.upper_error * estimate.upper_error /
+                   estimate.load_work_error);
 }
 
 }  // namespace
@@ -47,7 +65,7 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
   RecoveryEstimate estimate;
   estimate.element_error_sq.resize(num_tets);
   const int depth = state.tree.max_level();
-  double total = 0.0, raw_total = 0.0;
+  double total = 0.0, raw_total = 0.0, load_work_total = 0.0;
   for (Index t = 0; t < num_tets; ++t) {
     const Vector6d own = strain.row(t).transpose();
     Vector6d sum = Vector6d::Zero();
@@ -62,13 +80,19 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
     const double removed = displacement_share_removed(depth, level);
     estimate.element_error_sq[t] = error_sq * removed * removed;
     raw_total += error_sq;
+    load_work_total += error_sq * energy_share_removed(depth, level);
     total += estimate.element_error_sq[t];
     estimate.solution_energy_sq += volume[t] * twice_energy_density(own, lame);
   }
   estimate.reference_energy_sq = std::max(estimate.solution_energy_sq, state.solution_energy_scale);
   if (estimate.reference_energy_sq > 0.0) {
-    estimate.relative_error =
+    estimate.upper_error =
         kDisplacementPerEnergyError * std::sqrt(total / estimate.reference_energy_sq);
+    estimate.load_work_error = load_work_total / estimate.reference_energy_sq;
+    estimate.upper_only = state.material.plasticity.has_value();
+    estimate.relative_error = estimate.upper_only
+                                  ? estimate.upper_error
+                                  : std::sqrt(estimate.upper_error * estimate.load_work_error);
     estimate.relative_energy_error = std::sqrt(raw_total / estimate.reference_energy_sq);
   }
   return estimate;
@@ -87,7 +111,8 @@ void RecoveryIndicator::evaluate(const CutState& state, VectorXd& eta) const {
   const Index n = estimate.element_error_sq.size();
   eta.setZero(n);
   if (estimate.reference_energy_sq <= 0.0 || n == 0) return;
-  const double energy_tolerance = m_tolerance / kDisplacementPerEnergyError;
+  const double energy_tolerance =
+      upper_tolerance(estimate, m_tolerance) / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   eta = (estimate.element_error_sq / share).cwiseSqrt();
 }
@@ -120,7 +145,11 @@ double RecoveryIndicator::merge_indicator(const CutState& state, const std::arra
     loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
   const int depth = state.tree.max_level();
   const double removed = displacement_share_removed(depth, parent_level);
-  const double energy_tolerance = m_tolerance / kDisplacementPerEnergyError;
+  // A merge raises c, which the state's τ_z = τ²/c does not see (on the finest level c = 0 and
+  // τ_z = ∞): merging is judged against the smaller of τ_z and τ, never more loosely than the
+  // upper estimate alone would allow.
+  const double merge_tolerance = std::min(m_tolerance, upper_tolerance(estimate, m_tolerance));
+  const double energy_tolerance = merge_tolerance / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   return std::sqrt(loss * removed * removed / share);
 }

@@ -53,7 +53,10 @@ TEST(RecoveryEstimator, PeaksAtAKinkOfTheField) {
   const ActiveCut cut = ActiveCut::uniform(tree, 0);
   const test::CutSnapshot s = make_snapshot(cut, test_material(), kink, {});
   const RecoveryEstimate estimate = recovery_error_estimate(s.state());
-  EXPECT_GT(estimate.relative_error, 0.05);
+  EXPECT_GT(estimate.upper_error, 0.05);
+  EXPECT_GT(estimate.load_work_error, 0.0);
+  EXPECT_NEAR(estimate.relative_error, std::sqrt(estimate.upper_error * estimate.load_work_error),
+              1e-15);
   Index peak = 0;
   estimate.element_error_sq.maxCoeff(&peak);
   EXPECT_NEAR(node_centroid(tree, s.cut.flat.tet_nodes[peak]).x(), 0.4, 1.0 / 6.0 + 1e-12);
@@ -84,9 +87,14 @@ TEST(RecoveryIndicator, MarksTetsAboveTheirShareOfTheTolerance) {
   VectorXd eta;
   RecoveryIndicator(0.01).evaluate(s.state(), eta);
   ASSERT_EQ(eta.size(), estimate.element_error_sq.size());
-  // Σ η̂² = N (e/τ)²: the tets' shares add up to the estimate over the tolerance.
+  // Σ η̂² = N (z/τ_z)² with τ_z = (τ² z² / c)^⅓, i.e. N (e/τ)^{4/3}: the tets' shares of the
+  // tolerance on the upper estimate add up to it.
   const double n = static_cast<double>(eta.size());
-  EXPECT_NEAR(eta.squaredNorm() / n, std::pow(estimate.relative_error / 0.01, 2),
+  const double z = estimate.upper_error;
+  const double upper_tolerance = std::cbrt(0.01 * 0.01 * z * z / estimate.load_work_error);
+  EXPECT_NEAR(eta.squaredNorm() / n, std::pow(estimate.upper_error / upper_tolerance, 2),
+              1e-9 * eta.squaredNorm() / n);
+  EXPECT_NEAR(eta.squaredNorm() / n, std::pow(estimate.relative_error / 0.01, 4.0 / 3.0),
               1e-9 * eta.squaredNorm() / n);
   EXPECT_GT(eta.maxCoeff(), 1.0);
   EXPECT_THROW(RecoveryIndicator(0.0), InputError);

@@ -169,7 +169,9 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
                             {"dofs", nlohmann::json::array()},
                             {"hanging_vertices", nlohmann::json::array()},
                             {"estimated_error", nlohmann::json::array()},
-                            {"estimated_energy_error", nlohmann::json::array()}};
+                            {"estimated_energy_error", nlohmann::json::array()},
+                            {"estimated_upper_error", nlohmann::json::array()},
+                            {"estimated_load_work_error", nlohmann::json::array()}};
   for (const CutSample& sample : adaptive.history()) {
     history["step"].push_back(sample.step);
     history["time"].push_back(sample.time);
@@ -178,6 +180,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
     history["hanging_vertices"].push_back(sample.hanging);
     history["estimated_error"].push_back(sample.estimated_error);
     history["estimated_energy_error"].push_back(sample.estimated_energy_error);
+    history["estimated_upper_error"].push_back(sample.estimated_upper_error);
+    history["estimated_load_work_error"].push_back(sample.estimated_load_work_error);
   }
   block["history"] = history;
   Index refinements = 0, coarsenings = 0;

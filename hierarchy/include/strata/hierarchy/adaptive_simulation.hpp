@@ -143,6 +143,10 @@ struct CutSample {
   double estimated_error = 0.0;
   /// Relative energy-norm error against the exact solution (the estimate's raw form).
   double estimated_energy_error = 0.0;
+  /// The two brackets of estimated_error (RecoveryEstimate): the upper estimate z and the
+  /// relative error of the load's work c.
+  double estimated_upper_error = 0.0;
+  double estimated_load_work_error = 0.0;
 };
 
 /// How the run kept its tolerance.
