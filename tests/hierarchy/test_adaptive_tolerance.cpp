@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,14 +33,18 @@ struct PokedPlate {
   MatrixX3d probes =
       (MatrixX3d(3, 3) << 0.35, 0.25, 0.1, 0.5, 0.25, 0.05, 0.75, 0.25, 0.1).finished();
 
+  std::optional<Material> material_override;
+  double duration = 0.04;
+
   SolverSettings solver() const {
     SolverSettings settings;
     settings.integrator = Integrator::implicit_euler;
     settings.dt = 2e-3;
-    settings.duration = 0.04;
+    settings.duration = duration;
     return settings;
   }
   Material material() const {
+    if (material_override) return *material_override;
     Material m = rubber();
     m.mass_damping = 2.0;
     return m;
@@ -210,6 +215,39 @@ TEST(AdaptiveTolerance, AFractionOfOneNeverGoesToFullResolution) {
   plate.run(h, &report, nullptr, nullptr, &final_tets);
   EXPECT_GE(report.full_resolution_step, 0);
   EXPECT_EQ(final_tets, plate.coarse.tets.rows() * 64);
+}
+
+TEST(AdaptiveTolerance, AShearedBlockStaysWithinTheToleranceAndItsEstimateTracksTheError) {
+  // A second scene, unlike the plate: a thick St. Venant–Kirchhoff block (ν = 0.4) fixed at its
+  // base and pushed sideways and down by a small patch off-centre on its top.
+  PokedPlate block;
+  block.coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(0.5, 0.5, 0.3), {4, 4, 3});
+  block.fixed = {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
+  block.loads = {
+      box_load(Vector3d(0.1, 0.3, 0.3), Vector3d(0.2, 0.4, 0.3), Vector3d(40.0, 0, -20.0))};
+  block.probes = (MatrixX3d(3, 3) << 0.15, 0.35, 0.3, 0.35, 0.15, 0.3, 0.25, 0.25, 0.15).finished();
+  Material material;
+  material.model = MaterialModel::stvk;
+  material.youngs_modulus = 5e5;
+  material.poisson_ratio = 0.4;
+  material.density = 1200.0;
+  material.mass_damping = 10.0;
+  block.material_override = material;
+  block.duration = 0.03;
+
+  HierarchySettings full_settings = defaults(2);
+  full_settings.mode = HierarchyMode::full;
+  const std::vector<MatrixX3d> full = block.run(full_settings);
+  HierarchySettings h = defaults(2);
+  h.tolerance = 0.05;
+  ToleranceReport report;
+  const std::vector<MatrixX3d> adaptive = block.run(h, &report);
+  const double error = run_error(adaptive, full);
+  EXPECT_LE(error, h.tolerance);
+  EXPECT_EQ(report.full_resolution_step, -1);  // the cut stayed adaptive
+  // The effectivity the error control promises (estimate / true error over the run).
+  EXPECT_GT(report.max_estimated_error, 0.3 * error);
+  EXPECT_LT(report.max_estimated_error, 3.0 * error);
 }
 
 /// Elastic energy and the last estimate of a static run of a block pressed by a small patch
