@@ -30,10 +30,12 @@ double energy_share_removed(int depth, int level) {
   return 1.0 - std::ldexp(1.0, -2 * (depth - level));
 }
 
-/// The tolerance on the upper estimate z that the run's tolerance τ on e = √(z c) means. Under
-/// refinement c falls about as z² (c / z² = Σ_t η_t² (1 − 4^−(L−ℓ)) / Σ_t η_t,full² depends only
-/// on the levels of the tets), so with k = c / z² of this state, e ≤ τ ⟺ k z³ ≤ τ²:
-/// τ_z = (τ² z² / c)^⅓ (= z when e = τ).
+/// The share of the tolerance the tets' terms of z are marked against: τ_z = (τ² z² / c)^⅓ =
+/// z (τ/e)^⅔, which is z when e = τ. A heuristic, not a derivation: it would be exact if c fell
+/// as z² under refinement; with an error energy falling by 4 per level (c by 4, z² by 8) it
+/// would be z (τ/e)^{6/7}, which marks more per pass. The smaller exponent marks less and lets
+/// the next pass's estimate decide; the state's own c, τ² / c, marked far too much (README,
+/// "Error control"). Plastic: τ; c = 0 (every tet at the finest level): ∞.
 double upper_tolerance(const RecoveryEstimate& estimate, double tolerance) {
   if (estimate.upper_only) return tolerance;
   if (estimate.load_work_error <= 0.0) return std::numeric_limits<double>::infinity();
@@ -145,9 +147,9 @@ double RecoveryIndicator::merge_indicator(const CutState& state, const std::arra
     loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
   const int depth = state.tree.max_level();
   const double removed = displacement_share_removed(depth, parent_level);
-  // A merge raises c, which the state's τ_z = τ²/c does not see (on the finest level c = 0 and
-  // τ_z = ∞): merging is judged against the smaller of τ_z and τ, never more loosely than the
-  // upper estimate alone would allow.
+  // A merge raises c, which τ_z (from this state's c) does not see; on the finest level c = 0
+  // and τ_z = ∞. The merge is judged against the smaller of τ_z and τ, never more loosely than
+  // the upper estimate alone would allow.
   const double merge_tolerance = std::min(m_tolerance, upper_tolerance(estimate, m_tolerance));
   const double energy_tolerance = merge_tolerance / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;

@@ -47,13 +47,13 @@
 /// with strain jumps between neighbours (bending on coarse tets, concentrated loads), and is zero
 /// on the finest level.
 ///
-/// As a refinement indicator the estimate is normalised by an equidistributed share of the
-/// tolerance τ_z on z that e ≤ τ means. Under refinement c falls about as z² (c / z² depends only
-/// on the tets' levels), so with k = c / z² of the state, e ≤ τ ⟺ k z³ ≤ τ², and
-/// τ_z = (τ² z² / c)^⅓: η̂_t = √(N η_t,full² / ((τ_z/C)² ‖u‖_E²)), with N the number of active
-/// tets, so η̂ > 1 marks the tets whose error exceeds their share (refine_threshold 1), and
-/// Σ_t η̂_t² = N (e/τ)^{4/3}. Merging is judged against min(τ, τ_z): a merge raises c, which
-/// τ_z does not see.
+/// As a refinement indicator the estimate is normalised by an equidistributed share of a
+/// tolerance τ_z on z: η̂_t = √(N η_t,full² / ((τ_z/C)² ‖u‖_E²)), with N the number of active tets,
+/// so η̂ > 1 marks the tets whose error exceeds their share (refine_threshold 1). The heuristic
+/// τ_z = (τ² z² / c)^⅓ = z (τ/e)^⅔ is z when e = τ (it would mean e ≤ τ exactly if c fell as z²
+/// under refinement); then Σ_t η̂_t² = N (e/τ)^{4/3} (elastic, c > 0; plastic: τ_z = τ and
+/// N (e/τ)²; c = 0: τ_z = ∞ and η̂ = 0). The coarsening test of the children's η̂ uses the same
+/// normalisation; merge_indicator uses min(τ, τ_z), as a merge raises c, which τ_z does not see.
 #include "strata/hierarchy/refinement_indicator.hpp"
 
 namespace strata {
