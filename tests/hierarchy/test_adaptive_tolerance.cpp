@@ -250,13 +250,14 @@ TEST(AdaptiveTolerance, AShearedBlockStaysWithinTheToleranceAndItsEstimateTracks
   EXPECT_LT(report.max_estimated_error, 3.0 * error);
 }
 
-/// Elastic energy and the last estimate of a static run of a block pressed by a small patch
-/// (small strain: nearly linear), on the uniform cut at `level` or at full resolution.
+/// Elastic energy and the last estimate of a static run of a block pressed by a small patch, or
+/// loaded by its own weight (small strain: nearly linear), on the uniform cut at `level` or at
+/// full resolution.
 struct StaticBlockResult {
   double elastic_energy = 0.0;
   CutSample last;
 };
-StaticBlockResult static_block(HierarchyMode mode, int level) {
+StaticBlockResult static_block(HierarchyMode mode, int level, bool gravity = false) {
   const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 0.5), {4, 4, 2});
   const std::vector<DirichletSpec> fixed = {
       fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())};
@@ -268,7 +269,8 @@ StaticBlockResult static_block(HierarchyMode mode, int level) {
   HierarchySettings h = defaults(2);
   h.mode = mode;
   h.level = level;
-  AdaptiveSimulation sim(coarse, h, rubber(), fixed, loads, std::nullopt, Vector3d::Zero(), solver);
+  AdaptiveSimulation sim(coarse, h, rubber(), fixed, gravity ? std::vector<RegionLoad>{} : loads,
+                         std::nullopt, gravity ? Vector3d(0, 0, -9.81) : Vector3d::Zero(), solver);
   while (!sim.finished())
     sim.advance();
   return {sim.current().elastic_energy(), sim.history().back()};
@@ -292,6 +294,17 @@ TEST(AdaptiveTolerance, TheLoadWorkBracketEstimatesTheEnergyGapToTheFinestLevel)
     EXPECT_NEAR(cut.last.estimated_error,
                 std::sqrt(cut.last.estimated_upper_error * cut.last.estimated_load_work_error),
                 1e-12);
+  }
+  // Under its own weight (a distributed load) the roots are in range as well: there the
+  // factor 1 − 4^−(L−ℓ) is 15/16, on level 1 3/4.
+  const double weight_full = static_block(HierarchyMode::full, 0, true).elastic_energy;
+  for (int level : {0, 1}) {
+    const StaticBlockResult cut = static_block(HierarchyMode::uniform, level, true);
+    const double gap = (weight_full - cut.elastic_energy) / cut.elastic_energy;
+    ASSERT_GT(gap, 0.0) << "weight, level " << level;
+    const double effectivity = cut.last.estimated_load_work_error / gap;
+    EXPECT_GT(effectivity, 0.3) << "weight, level " << level << ", gap " << gap;
+    EXPECT_LT(effectivity, 3.0) << "weight, level " << level << ", gap " << gap;
   }
 }
 
