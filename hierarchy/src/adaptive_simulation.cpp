@@ -113,6 +113,8 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
     throw InputError(where + ".tolerance: must be in (0, 1)");
   if (!(settings.full_resolution_fraction > 0.0 && settings.full_resolution_fraction <= 1.0))
     throw InputError(where + ".full_resolution_fraction: must be in (0, 1]");
+  if (!(settings.coarsen_budget > 0.0 && settings.coarsen_budget <= 1.0))
+    throw InputError(where + ".coarsen_budget: must be in (0, 1]");
   validate_refinement_settings(settings.criteria, where);
   if (settings.mode == HierarchyMode::precomputed && !settings.precomputed)
     throw InputError(where + ".cut: mode \"precomputed\" needs a precomputed cut");
@@ -524,6 +526,10 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
     m_report.refused_refinements += changes.refused;
   }
   if (!coarsen) changes.coarsen.clear();
+  if (m_estimates_error && !changes.coarsen.empty())
+    changes.coarsen = merges_within_budget(state, m_estimate, changes.coarsen,
+                                           m_settings.coarsen_budget * m_settings.tolerance)
+                          .kept;
   return changes;
 }
 

@@ -1,6 +1,7 @@
 #include "strata/hierarchy/refinement_recovery_estimator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -43,6 +44,30 @@ double upper_tolerance(const RecoveryEstimate& estimate, double tolerance) {
                    estimate.load_work_error);
 }
 
+/// Σ_k 2 V_k ψ(E_k − Ē) over the eight children (flat tets), Ē their volume-weighted mean Green
+/// strain: the strain energy of the detail a merge into the parent averages away [J].
+double merge_loss(const CutState& state, const std::array<int, 8>& children) {
+  const TetMesh& mesh = state.flat.mesh;
+  const auto& strain = state.fields.green_strain;
+  std::array<double, 8> volume{};
+  Vector6d mean = Vector6d::Zero();
+  double total = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const auto corner = [&](int i) {
+      return Vector3d(mesh.vertices.row(mesh.tets(children[k], i)).transpose());
+    };
+    volume[k] = std::abs(tet_signed_volume(corner(0), corner(1), corner(2), corner(3)));
+    mean += volume[k] * strain.row(children[k]).transpose();
+    total += volume[k];
+  }
+  mean /= total;
+  const LameParameters lame = state.material.lame();
+  double loss = 0.0;
+  for (int k = 0; k < 8; ++k)
+    loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
+  return loss;
+}
+
 }  // namespace
 
 RecoveryEstimate recovery_error_estimate(const CutState& state) {
@@ -66,6 +91,7 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
 
   RecoveryEstimate estimate;
   estimate.element_error_sq.resize(num_tets);
+  estimate.element_raw_error_sq.resize(num_tets);
   const int depth = state.tree.max_level();
   double total = 0.0, raw_total = 0.0, load_work_total = 0.0;
   for (Index t = 0; t < num_tets; ++t) {
@@ -81,6 +107,7 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
     const int level = state.tree.level(state.flat.tet_nodes[t]);
     const double removed = displacement_share_removed(depth, level);
     estimate.element_error_sq[t] = error_sq * removed * removed;
+    estimate.element_raw_error_sq[t] = error_sq;
     raw_total += error_sq;
     load_work_total += error_sq * energy_share_removed(depth, level);
     total += estimate.element_error_sq[t];
@@ -127,24 +154,7 @@ double RecoveryIndicator::merge_indicator(const CutState& state, const std::arra
       state.recovery_estimate != nullptr ? *state.recovery_estimate : computed;
   const Index n = estimate.element_error_sq.size();
   if (estimate.reference_energy_sq <= 0.0 || n == 0) return 0.0;
-  const TetMesh& mesh = state.flat.mesh;
-  const auto& strain = state.fields.green_strain;
-  std::array<double, 8> volume{};
-  Vector6d mean = Vector6d::Zero();
-  double total = 0.0;
-  for (int k = 0; k < 8; ++k) {
-    const auto corner = [&](int i) {
-      return Vector3d(mesh.vertices.row(mesh.tets(children[k], i)).transpose());
-    };
-    volume[k] = std::abs(tet_signed_volume(corner(0), corner(1), corner(2), corner(3)));
-    mean += volume[k] * strain.row(children[k]).transpose();
-    total += volume[k];
-  }
-  mean /= total;
-  const LameParameters lame = state.material.lame();
-  double loss = 0.0;
-  for (int k = 0; k < 8; ++k)
-    loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
+  const double loss = merge_loss(state, children);
   const int depth = state.tree.max_level();
   const double removed = displacement_share_removed(depth, parent_level);
   // A merge raises c, which τ_z (from this state's c) does not see; on the finest level c = 0
@@ -154,6 +164,72 @@ double RecoveryIndicator::merge_indicator(const CutState& state, const std::arra
   const double energy_tolerance = merge_tolerance / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   return std::sqrt(loss * removed * removed / share);
+}
+
+BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimate& estimate,
+                                    const std::vector<NodeId>& parents, double budget) {
+  BudgetedMerges result;
+  result.predicted_error = estimate.relative_error;
+  const double reference = estimate.reference_energy_sq;
+  if (!(reference > 0.0) || parents.empty()) {
+    result.kept = parents;
+    std::sort(result.kept.begin(), result.kept.end());
+    return result;
+  }
+  const TetTree& tree = state.tree;
+  const FlatTreeMesh& flat = state.flat;
+  const Index num_tets = flat.mesh.tets.rows();
+  STRATA_VERIFY(estimate.element_raw_error_sq.size() == num_tets,
+                "merges_within_budget: the estimate is not of this state");
+  std::vector<int> node_tet(static_cast<std::size_t>(tree.pool_size()), -1);
+  for (Index t = 0; t < num_tets; ++t)
+    node_tet[flat.tet_nodes[t]] = static_cast<int>(t);
+  const int depth = tree.max_level();
+  const auto z_share = [&](int level) {
+    const double removed = displacement_share_removed(depth, level);
+    return removed * removed;
+  };
+  struct Merge {
+    NodeId parent;
+    double dz;  // rise of z² ‖u‖² [J]
+    double dc;  // rise of c ‖u‖² [J]
+  };
+  std::vector<Merge> merges;
+  merges.reserve(parents.size());
+  for (const NodeId parent : parents) {
+    std::array<int, 8> children{};
+    double children_sq = 0.0;
+    for (int k = 0; k < 8; ++k) {
+      children[k] = node_tet[tree.child(parent, k)];
+      STRATA_VERIFY(children[k] >= 0, "merges_within_budget: a child of a merge is not active");
+      children_sq += estimate.element_raw_error_sq[children[k]];
+    }
+    const int level = tree.level(parent);
+    const double parent_sq = std::max(4.0 * children_sq, children_sq + merge_loss(state, children));
+    merges.push_back({parent, parent_sq * z_share(level) - children_sq * z_share(level + 1),
+                      parent_sq * energy_share_removed(depth, level) -
+                          children_sq * energy_share_removed(depth, level + 1)});
+  }
+  const bool upper_only = estimate.upper_only;
+  std::sort(merges.begin(), merges.end(), [&](const Merge& a, const Merge& b) {
+    const double ra = upper_only ? a.dz : a.dc, rb = upper_only ? b.dz : b.dc;
+    return ra != rb ? ra < rb : a.parent < b.parent;
+  });
+  const double z_scale = kDisplacementPerEnergyError * kDisplacementPerEnergyError / reference;
+  double z_sq = estimate.upper_error * estimate.upper_error / z_scale;  // Σ terms of z² [J]
+  double c = estimate.load_work_error * reference;                      // Σ terms of c [J]
+  for (const Merge& merge : merges) {
+    const double z = std::sqrt(std::max(0.0, (z_sq + merge.dz) * z_scale));
+    const double predicted =
+        upper_only ? z : std::sqrt(z * std::max(0.0, (c + merge.dc) / reference));
+    if (predicted > budget) break;
+    z_sq += merge.dz;
+    c += merge.dc;
+    result.kept.push_back(merge.parent);
+    result.predicted_error = predicted;
+  }
+  std::sort(result.kept.begin(), result.kept.end());
+  return result;
 }
 
 }  // namespace strata

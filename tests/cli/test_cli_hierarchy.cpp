@@ -198,6 +198,7 @@ TEST(CliHierarchy, UnmetToleranceWarnsAndIsReported) {
   const json free_stats = read_json(folder.path() / "out" / "free" / "stats.json");
   EXPECT_TRUE(free_stats["hierarchy"]["tolerance_met"].get<bool>());
   EXPECT_LE(free_stats["hierarchy"]["estimated_error"].get<double>(), 0.3);
+  EXPECT_EQ(free_stats["hierarchy"]["coarsen_budget"], 0.8);  // the default
 }
 
 TEST(CliHierarchy, BadToleranceNamesTheKey) {
@@ -208,6 +209,14 @@ TEST(CliHierarchy, BadToleranceNamesTheKey) {
   const CliResult bad = run_strata("run bad.json --quiet", folder.path());
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_THAT(bad.err, HasSubstr("hierarchy.tolerance"));
+  for (double budget : {0.0, 1.5}) {
+    scene = slab_scene("adaptive");
+    scene["hierarchy"]["coarsen_budget"] = budget;
+    write_text(folder.path() / "bad_budget.json", scene.dump(2));
+    const CliResult bad_budget = run_strata("run bad_budget.json --quiet", folder.path());
+    EXPECT_EQ(bad_budget.exit_code, 2);
+    EXPECT_THAT(bad_budget.err, HasSubstr("hierarchy.coarsen_budget"));
+  }
 }
 
 TEST(CliHierarchy, ACutPastTheFullResolutionFractionGoesOnAtFullResolution) {

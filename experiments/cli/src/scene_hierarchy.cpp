@@ -9,11 +9,13 @@
 namespace strata::app::detail {
 
 HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem::path& folder) {
+  // clang-format off
   value.expect_object({"levels", "mode", "level", "adapt_every", "max_passes", "indicator",
                        "refine_threshold", "coarsen_tolerance", "coarsen_indicator_fraction",
                        "stress_floor", "min_steps_between_changes", "max_active_elements",
                        "max_level", "balance", "tolerance", "initial_adaptation",
-                       "in_step_refinement", "full_resolution_fraction", "cut"});
+                       "in_step_refinement", "full_resolution_fraction", "coarsen_budget", "cut"});
+  // clang-format on
   HierarchySettings settings;
   settings.levels = value.at("levels").integer(0);
   if (settings.levels > 8) value.at("levels").fail("must be at most 8");
@@ -55,6 +57,10 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
     settings.full_resolution_fraction = value.at("full_resolution_fraction").positive();
     if (settings.full_resolution_fraction > 1.0)
       value.at("full_resolution_fraction").fail("must be in (0, 1]");
+  }
+  if (value.has("coarsen_budget")) {
+    settings.coarsen_budget = value.at("coarsen_budget").positive();
+    if (settings.coarsen_budget > 1.0) value.at("coarsen_budget").fail("must be in (0, 1]");
   }
   RefinementSettings& criteria = settings.criteria;
   if (value.has("refine_threshold")) {

@@ -219,6 +219,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
   block["initial_newton_iterations"] = report.initial_newton_iterations;
   block["initial_adaptation_seconds"] = report.initial_adaptation_seconds;
   block["full_resolution_fraction"] = settings.full_resolution_fraction;
+  block["coarsen_budget"] = settings.coarsen_budget;
   if (report.full_resolution_step >= 0) {
     block["full_resolution_step"] = report.full_resolution_step;
   } else {

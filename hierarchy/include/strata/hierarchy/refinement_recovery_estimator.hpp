@@ -54,6 +54,8 @@
 /// under refinement); then Σ_t η̂_t² = N (e/τ)^{4/3} (elastic, c > 0; plastic: τ_z = τ and
 /// N (e/τ)²; c = 0: τ_z = ∞ and η̂ = 0). The coarsening test of the children's η̂ uses the same
 /// normalisation; merge_indicator uses min(τ, τ_z), as a merge raises c, which τ_z does not see.
+#include <vector>
+
 #include "strata/hierarchy/refinement_indicator.hpp"
 
 namespace strata {
@@ -63,6 +65,7 @@ inline constexpr double kDisplacementPerEnergyError = 1.0;
 
 struct RecoveryEstimate {
   VectorXd element_error_sq;        ///< η_t,full² per flat tet [J] (energy norm², 2ψ·V)
+  VectorXd element_raw_error_sq;    ///< η_t² per flat tet, against the exact solution [J]
   double solution_energy_sq = 0.0;  ///< ‖u‖_E² of this state [J]
   /// max(‖u‖_E², state.solution_energy_scale): what the relative errors are relative to [J].
   double reference_energy_sq = 0.0;
@@ -81,6 +84,22 @@ struct RecoveryEstimate {
 
 /// The estimate of `state` (a tree of depth state.tree.max_level()).
 RecoveryEstimate recovery_error_estimate(const CutState& state);
+
+/// The merges of one change that fit a budget on the estimate.
+struct BudgetedMerges {
+  std::vector<NodeId> kept;      ///< parents to merge, ascending id
+  double predicted_error = 0.0;  ///< the estimate e predicted after those merges
+};
+
+/// The merges of `parents` (each a parent whose eight children are active tets of state.flat)
+/// that keep the predicted estimate e within `budget`. A merge replaces the children's terms by
+/// the parent's, whose squared error is predicted as the larger of 4 Σ_k η_k² (the error energy
+/// of linear elements rises by 4 per level coarser) and Σ_k η_k² plus the energy the merge removes
+/// (RecoveryIndicator::merge_indicator); z and c follow with the parent's level. Merges are taken
+/// in order of their predicted rise of c (of z for plastic materials), smallest first, while the
+/// predicted e stays within the budget. A state without deformation keeps every merge.
+BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimate& estimate,
+                                    const std::vector<NodeId>& parents, double budget);
 
 class RecoveryIndicator final : public RefinementIndicator {
  public:
