@@ -6,7 +6,10 @@
 //     model (rest data, tet partition) and the reduced one (K_q's pattern and assembly plan) of
 //     the flattened cut;
 //   - cut_stiffness/assemble/<raw|psd>/threads:<n>: one K_q = Pᵀ K P at a deformed state, as a
-//     Newton iteration assembles it.
+//     Newton iteration assembles it;
+//   - cut_stiffness/estimate/threads:<n>: the test an adaptive run makes of every step's result,
+//     the tets' Green strains and stresses at a deformed state and the recovery error estimate
+//     (refinement_recovery_estimator.hpp).
 // Counters: tets, DOFs (3 · free vertices), hanging vertices, K_q's non-zeros.
 #include <benchmark/benchmark.h>
 
@@ -18,7 +21,9 @@
 #include <strata/core/fem/elastic_model.hpp>
 #include <strata/core/sim/embedded_model.hpp>
 #include <strata/hierarchy/active_cut.hpp>
+#include <strata/hierarchy/cut_state.hpp>
 #include <strata/hierarchy/hanging_constraints.hpp>
+#include <strata/hierarchy/refinement_recovery_estimator.hpp>
 
 namespace strata::bench {
 namespace {
@@ -79,6 +84,17 @@ void build_benchmark(benchmark::State& state, int threads) {
   set_cut_counters(state, g, embedded);
 }
 
+/// A smooth bend of the free vertices: every element strained, none inverted.
+VectorXd bent_state(const EmbeddedElasticModel& embedded) {
+  VectorXd q = embedded.rest_positions();
+  for (Index i = 0; i < embedded.num_dof_vertices(); ++i) {
+    const double x = q[3 * i];
+    q[3 * i + 2] += 0.05 * x * x;
+    q[3 * i + 1] *= 1.0 + 0.02 * q[3 * i + 2];
+  }
+  return q;
+}
+
 void assemble_benchmark(benchmark::State& state, bool project_psd, int threads) {
   const ThreadLimit limit(threads);
   const GradedCut& g = graded_cut();
@@ -86,13 +102,7 @@ void assemble_benchmark(benchmark::State& state, bool project_psd, int threads) 
   const ElasticModel model(mesh.vertices, mesh.tets, g.material);
   const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
                                       g.cut->constraints.free_vertices());
-  // A smooth bend of the free vertices: every element strained, none inverted.
-  VectorXd q = embedded.rest_positions();
-  for (Index i = 0; i < embedded.num_dof_vertices(); ++i) {
-    const double x = q[3 * i];
-    q[3 * i + 2] += 0.05 * x * x;
-    q[3 * i + 1] *= 1.0 + 0.02 * q[3 * i + 2];
-  }
+  const VectorXd q = bent_state(embedded);
   SparseMatrixd K;
   embedded.stiffness(q, K, project_psd);  // sets the pattern, outside the timing
   for (auto _ : state) {
@@ -101,6 +111,28 @@ void assemble_benchmark(benchmark::State& state, bool project_psd, int threads) 
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(state.iterations() * model.num_tets());
+  set_cut_counters(state, g, embedded);
+}
+
+void estimate_benchmark(benchmark::State& state, int threads) {
+  const ThreadLimit limit(threads);
+  const GradedCut& g = graded_cut();
+  const TetMesh& mesh = g.cut->flat.mesh;
+  const ElasticModel model(mesh.vertices, mesh.tets, g.material);
+  const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
+                                      g.cut->constraints.free_vertices());
+  const VectorXd x = embedded.expand(bent_state(embedded));
+  const VectorXd loads = VectorXd::Zero(x.size());
+  const VectorXd mass = VectorXd::Zero(mesh.vertices.rows());
+  double error = 0.0;
+  for (auto _ : state) {
+    const TetFields fields = model.tet_fields(x);
+    const CutState cut_state{*g.tree, g.cut->flat, x, fields, loads, mass, g.material};
+    error = recovery_error_estimate(cut_state).relative_error;
+    benchmark::DoNotOptimize(error);
+  }
+  state.SetItemsProcessed(state.iterations() * model.num_tets());
+  state.counters["estimate"] = error;
   set_cut_counters(state, g, embedded);
 }
 
@@ -116,6 +148,10 @@ const bool registered = [] {
           assemble_benchmark, psd, threads)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
+    benchmark::RegisterBenchmark(("cut_stiffness/estimate" + suffix).c_str(), estimate_benchmark,
+                                 threads)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   }
   return true;
 }();

@@ -1,5 +1,8 @@
 #include "strata/hierarchy/refinement_indicator.hpp"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -22,11 +25,14 @@ VectorXd tet_stress_norms(const Eigen::Matrix<double, Eigen::Dynamic, 6>& cauchy
 
 VectorXd tet_rest_volumes(const TetMesh& mesh) {
   VectorXd volumes(mesh.tets.rows());
-  for (Index t = 0; t < mesh.tets.rows(); ++t)
-    volumes[t] = tet_signed_volume(mesh.vertices.row(mesh.tets(t, 0)).transpose(),
-                                   mesh.vertices.row(mesh.tets(t, 1)).transpose(),
-                                   mesh.vertices.row(mesh.tets(t, 2)).transpose(),
-                                   mesh.vertices.row(mesh.tets(t, 3)).transpose());
+  tbb::parallel_for(Index(0), Index(mesh.tets.rows()), Index(4096), [&](Index begin) {
+    const Index end = std::min<Index>(begin + 4096, mesh.tets.rows());
+    for (Index t = begin; t < end; ++t)
+      volumes[t] = tet_signed_volume(mesh.vertices.row(mesh.tets(t, 0)).transpose(),
+                                     mesh.vertices.row(mesh.tets(t, 1)).transpose(),
+                                     mesh.vertices.row(mesh.tets(t, 2)).transpose(),
+                                     mesh.vertices.row(mesh.tets(t, 3)).transpose());
+  });
   return volumes;
 }
 

@@ -1,9 +1,12 @@
 #include "strata/hierarchy/refinement_recovery_estimator.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -11,6 +14,9 @@
 namespace strata {
 
 namespace {
+
+/// Tets per parallel task.
+constexpr Index kTetChunk = 2048;
 
 /// 2ψ(e) = 2μ e:e + λ tr(e)² for a symmetric tensor in Voigt form [xx yy zz xy yz xz].
 double twice_energy_density(const Vector6d& e, const LameParameters& lame) {
@@ -93,25 +99,38 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
   estimate.element_error_sq.resize(num_tets);
   estimate.element_raw_error_sq.resize(num_tets);
   const int depth = state.tree.max_level();
+  std::vector<double> removed(static_cast<std::size_t>(depth) + 1), c_share(removed.size());
+  for (int level = 0; level <= depth; ++level) {
+    removed[level] = displacement_share_removed(depth, level);
+    c_share[level] = energy_share_removed(depth, level);
+  }
+  // The tets' terms in parallel, their sums in tet order (the same at any thread count).
+  VectorXd load_work_terms(num_tets), energy_terms(num_tets);
+  tbb::parallel_for(Index(0), num_tets, kTetChunk, [&](Index begin) {
+    const Index end = std::min(begin + kTetChunk, num_tets);
+    for (Index t = begin; t < end; ++t) {
+      const Vector6d own = strain.row(t).transpose();
+      Vector6d sum = Vector6d::Zero();
+      double vertex_terms = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const Vector6d d = recovered.row(mesh.tets(t, k)).transpose() - own;
+        vertex_terms += twice_energy_density(d, lame);
+        sum += d;
+      }
+      const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
+      const int level = state.tree.level(state.flat.tet_nodes[t]);
+      estimate.element_error_sq[t] = error_sq * removed[level] * removed[level];
+      estimate.element_raw_error_sq[t] = error_sq;
+      load_work_terms[t] = error_sq * c_share[level];
+      energy_terms[t] = volume[t] * twice_energy_density(own, lame);
+    }
+  });
   double total = 0.0, raw_total = 0.0, load_work_total = 0.0;
   for (Index t = 0; t < num_tets; ++t) {
-    const Vector6d own = strain.row(t).transpose();
-    Vector6d sum = Vector6d::Zero();
-    double vertex_terms = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      const Vector6d d = recovered.row(mesh.tets(t, k)).transpose() - own;
-      vertex_terms += twice_energy_density(d, lame);
-      sum += d;
-    }
-    const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
-    const int level = state.tree.level(state.flat.tet_nodes[t]);
-    const double removed = displacement_share_removed(depth, level);
-    estimate.element_error_sq[t] = error_sq * removed * removed;
-    estimate.element_raw_error_sq[t] = error_sq;
-    raw_total += error_sq;
-    load_work_total += error_sq * energy_share_removed(depth, level);
+    raw_total += estimate.element_raw_error_sq[t];
+    load_work_total += load_work_terms[t];
     total += estimate.element_error_sq[t];
-    estimate.solution_energy_sq += volume[t] * twice_energy_density(own, lame);
+    estimate.solution_energy_sq += energy_terms[t];
   }
   estimate.reference_energy_sq = std::max(estimate.solution_energy_sq, state.solution_energy_scale);
   if (estimate.reference_energy_sq > 0.0) {
