@@ -185,6 +185,23 @@ AdaptiveSimulation::AdaptiveSimulation(
     return !m_in_contact.contains(parent) &&
            dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
   });
+  // The merges of a decision: none where it only refines; with the error estimate, those within
+  // the coarsening budget. Chosen before the controller fits the refinements to the element
+  // budget, which counts the tets the merges free.
+  m_controller->set_merge_filter(
+      [this](const CutState& state, const std::vector<NodeId>& parents) -> std::vector<NodeId> {
+        if (!m_decision_merges) return {};
+        if (!m_estimates_error) return parents;
+        RecoveryEstimate computed;
+        const RecoveryEstimate* estimate = state.recovery_estimate;
+        if (estimate == nullptr) {
+          computed = recovery_error_estimate(state);
+          estimate = &computed;
+        }
+        return merges_within_budget(state, *estimate, parents,
+                                    m_settings.coarsen_budget * m_settings.tolerance)
+            .kept;
+      });
   std::vector<RegionLoad> constant_loads;
   for (const RegionLoad& load : loads) {
     if (load.amplitude.empty()) {
@@ -221,11 +238,10 @@ void AdaptiveSimulation::initial_adaptation() {
   // Only the pattern of the response matters here, not its last digits.
   statics.newton_tolerance = std::max(statics.newton_tolerance, 1e-6);
   // Each pass solves its cut once: no later solve reuses a Cholesky factor, the case for which
-  // `automatic` keeps CHOLMOD below kMultigridMinDofs. The tree's multigrid (CHOLMOD on a cut
-  // without coarser levels) was as fast at 225 free DOFs and 1.8–2.4 times faster at 1.2k–6.5k
-  // (README, "Error control").
-  if (statics.linear_solver == LinearSolverKind::automatic)
-    statics.linear_solver = LinearSolverKind::multigrid;
+  // `automatic` keeps CHOLMOD below kMultigridMinDofs. On a cut with coarser levels the tree's
+  // multigrid was as fast at 225 free DOFs and 1.8–2.4 times faster at 1.2k–6.5k (README, "Error
+  // control"); a cut without them keeps the automatic choice.
+  const bool automatic_solver = statics.linear_solver == LinearSolverKind::automatic;
   bool changed = false;  // m_constrained and m_mesh_external are ahead of m_simulation
   // Each pass after the first starts Newton from the previous pass's response carried to the
   // refined cut through the tree (the previous flat mesh and its deformed positions); with
@@ -235,6 +251,9 @@ void AdaptiveSimulation::initial_adaptation() {
   for (int pass = 0; pass < m_settings.max_passes && !all_at_level(*m_cut, max_refine_level());
        ++pass) {
     SimulationOptions options = flatten(0);
+    if (automatic_solver)
+      statics.linear_solver =
+          options.nested_spaces.empty() ? LinearSolverKind::automatic : LinearSolverKind::multigrid;
     m_mesh_external = peak_loads(options);
     options.extra_mesh_forces = m_mesh_external;
     options.extra_timed_mesh_forces.clear();
@@ -279,8 +298,8 @@ void AdaptiveSimulation::initial_adaptation() {
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
     if (m_estimates_error && estimate.relative_error <= m_settings.tolerance) break;
-    CutChanges changes = m_controller->decide(state, *m_cut);
-    changes.coarsen.clear();
+    m_decision_merges = false;
+    const CutChanges changes = m_controller->decide(state, *m_cut);
     m_report.refused_refinements += changes.refused;
     if (changes.refine.empty()) break;
     if (m_obstacles.empty()) {
@@ -525,17 +544,13 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const bool within_tolerance =
       m_estimates_error && m_estimate.relative_error <= m_settings.tolerance;
   if (!coarsen && (!refine || within_tolerance)) return {};
+  m_decision_merges = coarsen;
   CutChanges changes = m_controller->decide(state, *m_cut);
   if (!refine || within_tolerance) {
     changes.refine.clear();
   } else {
     m_report.refused_refinements += changes.refused;
   }
-  if (!coarsen) changes.coarsen.clear();
-  if (m_estimates_error && !changes.coarsen.empty())
-    changes.coarsen = merges_within_budget(state, m_estimate, changes.coarsen,
-                                           m_settings.coarsen_budget * m_settings.tolerance)
-                          .kept;
   return changes;
 }
 

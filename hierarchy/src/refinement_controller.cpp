@@ -46,6 +46,10 @@ void RefinementController::set_coarsening_veto(std::function<bool(NodeId)> may_c
   m_may_coarsen = std::move(may_coarsen);
 }
 
+void RefinementController::set_merge_filter(MergeFilter filter) {
+  m_merge_filter = std::move(filter);
+}
+
 long RefinementController::last_change_step(NodeId n) const {
   return n >= 0 && static_cast<std::size_t>(n) < m_last_change.size() ? m_last_change[n] : kNever;
 }
@@ -154,6 +158,8 @@ CutChanges RefinementController::decide(const CutState& state, const ActiveCut& 
     if (mergeable) changes.coarsen.push_back(parent);
   }
   std::sort(changes.coarsen.begin(), changes.coarsen.end());
+  if (m_merge_filter && !changes.coarsen.empty())
+    changes.coarsen = m_merge_filter(state, changes.coarsen);
 
   // Budget: refine in order of η while the cut (after coarsening) stays within it.
   Index size = cut.size() - 7 * static_cast<Index>(changes.coarsen.size());

@@ -24,9 +24,10 @@ VectorXd tet_stress_norms(const Eigen::Matrix<double, Eigen::Dynamic, 6>& cauchy
 }
 
 VectorXd tet_rest_volumes(const TetMesh& mesh) {
+  constexpr Index kChunk = 4096;  // tets per parallel task
   VectorXd volumes(mesh.tets.rows());
-  tbb::parallel_for(Index(0), Index(mesh.tets.rows()), Index(4096), [&](Index begin) {
-    const Index end = std::min<Index>(begin + 4096, mesh.tets.rows());
+  tbb::parallel_for(Index(0), Index(mesh.tets.rows()), kChunk, [&](Index begin) {
+    const Index end = std::min<Index>(begin + kChunk, mesh.tets.rows());
     for (Index t = begin; t < end; ++t)
       volumes[t] = tet_signed_volume(mesh.vertices.row(mesh.tets(t, 0)).transpose(),
                                      mesh.vertices.row(mesh.tets(t, 1)).transpose(),

@@ -230,22 +230,34 @@ BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimat
                           children_sq * energy_share_removed(depth, level + 1)});
   }
   const bool upper_only = estimate.upper_only;
-  std::sort(merges.begin(), merges.end(), [&](const Merge& a, const Merge& b) {
-    const double ra = upper_only ? a.dz : a.dc, rb = upper_only ? b.dz : b.dc;
-    return ra != rb ? ra < rb : a.parent < b.parent;
-  });
   const double z_scale = kDisplacementPerEnergyError * kDisplacementPerEnergyError / reference;
   double z_sq = estimate.upper_error * estimate.upper_error / z_scale;  // Σ terms of z² [J]
   double c = estimate.load_work_error * reference;                      // Σ terms of c [J]
-  for (const Merge& merge : merges) {
-    const double z = std::sqrt(std::max(0.0, (z_sq + merge.dz) * z_scale));
-    const double predicted =
-        upper_only ? z : std::sqrt(z * std::max(0.0, (c + merge.dc) / reference));
-    if (predicted > budget) break;
+  // The estimate after the merges so far plus rises (dz, dc).
+  const auto predicted = [&](double dz, double dc) {
+    const double z = std::sqrt(std::max(0.0, (z_sq + dz) * z_scale));
+    return upper_only ? z : std::sqrt(z * std::max(0.0, (c + dc) / reference));
+  };
+  // Cheapest first: each merge by the estimate it alone would leave.
+  std::vector<double> alone(merges.size());
+  for (std::size_t i = 0; i < merges.size(); ++i)
+    alone[i] = predicted(merges[i].dz, merges[i].dc);
+  std::vector<std::size_t> order(merges.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return alone[a] != alone[b] ? alone[a] < alone[b] : merges[a].parent < merges[b].parent;
+  });
+  // Every merge that still fits: one that does not may leave room for a later one that raises
+  // the other bracket less.
+  for (const std::size_t i : order) {
+    const Merge& merge = merges[i];
+    const double after = predicted(merge.dz, merge.dc);
+    if (after > budget) continue;
     z_sq += merge.dz;
     c += merge.dc;
     result.kept.push_back(merge.parent);
-    result.predicted_error = predicted;
+    result.predicted_error = after;
   }
   std::sort(result.kept.begin(), result.kept.end());
   return result;

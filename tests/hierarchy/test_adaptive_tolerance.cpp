@@ -308,8 +308,8 @@ TEST(AdaptiveTolerance, TheLoadWorkBracketEstimatesTheEnergyGapToTheFinestLevel)
 TEST(AdaptiveTolerance, CoarseningKeepsTheEstimateWithinTheTolerance) {
   // A cantilever of one root through its thickness sagging under its own weight, backward Euler
   // with light damping, τ = 2 %: as it settles the periodic coarsening finds many sibling groups
-  // whose stresses agree. Each group alone is small, together they lifted the estimate of the
-  // transferred state above τ (2.07 % at one step) before merges were held to the budget.
+  // whose stresses agree. Each group alone is small; merged together without the coarsening
+  // budget they lift the estimate of the transferred state above τ (2.07 % at step 10).
   const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 0.1, 0.1), {10, 1, 1});
   Material material = rubber();
   material.youngs_modulus = 5e6;
@@ -330,7 +330,9 @@ TEST(AdaptiveTolerance, CoarseningKeepsTheEstimateWithinTheTolerance) {
   Index coarsened = 0;
   for (const CutChangeRecord& change : sim.changes())
     coarsened += change.coarsened;
-  EXPECT_GT(coarsened, 50);  // the budget left the coarsening something to do
+  // The budget defers merges rather than stopping them: the run merges 71 groups with it, as
+  // many as without it; more than 50 shows the coarsening still does its job.
+  EXPECT_GT(coarsened, 50);
   const ToleranceReport report = sim.tolerance_report();
   EXPECT_EQ(report.steps_over_tolerance, 0);
   EXPECT_LE(report.max_estimated_error, h.tolerance);

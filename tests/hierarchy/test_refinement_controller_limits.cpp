@@ -1,5 +1,6 @@
-// Refinement controller limits: budget, refinement and coarsening vetoes, minimum steps between
-// changes, reused node ids, level cap, 2:1 balance, a plugged-in indicator, settings validation.
+// Refinement controller limits: budget, refinement and coarsening vetoes, the driver's merge
+// filter against the budget, minimum steps between changes, reused node ids, level cap, 2:1
+// balance, a plugged-in indicator, settings validation.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -41,6 +42,36 @@ TEST(RefinementController, BudgetIsRespectedLargestFirst) {
     EXPECT_LE(cut.size(), settings.max_active_elements);
   }
   EXPECT_GT(cut.size(), settings.max_active_elements - 7);
+}
+
+TEST(RefinementController, MergeFilterChoosesTheMergesBeforeTheElementBudget) {
+  // A bump on a uniform level-1 cut: tets under it ask for refinement, siblings far from it
+  // merge. With the budget at the cut's size, only the tets the merges free can be refined, so
+  // the refinements follow the merges the driver's filter keeps.
+  TetTree tree(test::slab(), 3);
+  const ActiveCut cut = ActiveCut::uniform(tree, 1);
+  const CutSnapshot s = make_snapshot(cut, test::test_material(), steady_bump(), {}, kGravity, 0);
+  RefinementSettings settings = fast_settings();
+  settings.max_active_elements = cut.size();
+  const CutChanges all = RefinementController(settings).decide(s.state(), cut);
+  ASSERT_GE(all.coarsen.size(), 3u);
+  ASSERT_GE(all.over_threshold, 3);
+  for (const std::size_t keep : {std::size_t(0), std::size_t(2)}) {
+    RefinementController controller(settings);
+    std::size_t offered = 0;
+    controller.set_merge_filter([&](const CutState&, const std::vector<NodeId>& parents) {
+      offered = parents.size();
+      return std::vector<NodeId>(parents.begin(), parents.begin() + keep);
+    });
+    const CutChanges some = controller.decide(s.state(), cut);
+    EXPECT_EQ(offered, all.coarsen.size());
+    EXPECT_EQ(some.coarsen.size(), keep);
+    EXPECT_EQ(some.refine.size(), keep) << "keep " << keep;
+    EXPECT_EQ(some.refused, some.over_threshold - static_cast<Index>(keep));
+    EXPECT_LE(cut.size() - 7 * static_cast<Index>(some.coarsen.size()) +
+                  7 * static_cast<Index>(some.refine.size()),
+              settings.max_active_elements);
+  }
 }
 
 TEST(RefinementController, VetoIsHonoured) {

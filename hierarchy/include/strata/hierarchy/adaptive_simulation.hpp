@@ -296,6 +296,8 @@ class AdaptiveSimulation final : public SimulationRun {
   HierarchySettings m_settings;
   /// The indicator is an error estimate (refinement_indicator_registry.hpp).
   bool m_estimates_error = false;
+  /// Whether the controller's decision in progress may merge (its merge filter reads it).
+  bool m_decision_merges = true;
   Material m_material;
   std::vector<DirichletSpec> m_dirichlet;
   std::optional<GroundPlane> m_ground;

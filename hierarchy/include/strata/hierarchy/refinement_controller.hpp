@@ -7,7 +7,8 @@
 /// - refine an active node n when η_n > refine_threshold, its level is below max_level, at least
 ///   min_steps_between_changes steps have passed since n last changed, and the driver's veto
 ///   `may_refine(n)` (if set) allows it. With a budget of active elements, the largest η are
-///   refined first and refinement stops before the cut would exceed the budget (+7 per node).
+///   refined first and refinement stops before the cut would exceed the budget (+7 per node, −7
+///   per merge kept).
 /// - coarsen a parent p whose eight children are all active when (a) every child has
 ///   η_k < coarsen_indicator_fraction · refine_threshold (none of them wants refinement, with a
 ///   margin), (b) the children's stresses agree:
@@ -15,7 +16,8 @@
 ///   (c) p has not changed for min_steps_between_changes steps, (d) the driver's veto
 ///   `may_coarsen(p)` (if set) allows it, and (e) with `balance`, the cut stays 2:1 balanced (no
 ///   active tet touching p's children, or planned to be refined next to them, is finer than p's
-///   children).
+///   children), and (f) the driver's merge filter (if set) keeps p among the merges (a) – (e)
+///   allow.
 /// - no node is both refined and coarsened in one decision: a refined node's parent is never
 ///   coarsened (its η exceeds the coarsening bound).
 ///
@@ -103,6 +105,12 @@ class RefinementController {
   /// may_coarsen(parent) (e.g. false for nodes touching fixed or prescribed regions, to keep them
   /// exact at the level they were refined to). Empty: all.
   void set_coarsening_veto(std::function<bool(NodeId)> may_coarsen);
+  /// The driver's choice among the merges the rules allow (ascending parent ids in, a subset in
+  /// ascending order out), made before the refinements are fitted to max_active_elements (e.g. a
+  /// budget on an error estimate). Empty: all.
+  using MergeFilter =
+      std::function<std::vector<NodeId>(const CutState&, const std::vector<NodeId>&)>;
+  void set_merge_filter(MergeFilter filter);
 
   /// The changes the criteria ask for on `cut` (whose flattening is `state.flat`), at
   /// `state.step`. Does not modify anything.
@@ -128,6 +136,7 @@ class RefinementController {
   std::unique_ptr<RefinementIndicator> m_indicator;
   std::function<bool(NodeId)> m_may_refine;
   std::function<bool(NodeId)> m_may_coarsen;
+  MergeFilter m_merge_filter;
   std::vector<long> m_last_change;  ///< per node id
   std::vector<int> m_change_count;  ///< per node id
 };

@@ -95,9 +95,11 @@ struct BudgetedMerges {
 /// that keep the predicted estimate e within `budget`. A merge replaces the children's terms by
 /// the parent's, whose squared error is predicted as the larger of 4 Σ_k η_k² (the error energy
 /// of linear elements rises by 4 per level coarser) and Σ_k η_k² plus the energy the merge removes
-/// (RecoveryIndicator::merge_indicator); z and c follow with the parent's level. Merges are taken
-/// in order of their predicted rise of c (of z for plastic materials), smallest first, while the
-/// predicted e stays within the budget. A state without deformation keeps every merge.
+/// (RecoveryIndicator::merge_indicator); z and c follow with the parent's level. The merges are
+/// visited in order of the estimate each alone would leave, and each is kept if the predicted e
+/// with it and the merges kept before stays within the budget. Every rise is ≥ 0, so a state
+/// whose estimate already exceeds the budget keeps none. A state without deformation keeps every
+/// merge.
 BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimate& estimate,
                                     const std::vector<NodeId>& parents, double budget);
 
