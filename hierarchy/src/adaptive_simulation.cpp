@@ -532,7 +532,10 @@ VectorXd AdaptiveSimulation::criteria_loads(const Simulation& simulation) {
 CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
-  const TetFields fields = sim.model().tet_fields(sim.positions());
+  // The estimate needs the strains only; the stresses follow when the decision goes on to the
+  // controller (most steps of a run end at the estimate).
+  TetFields fields;
+  fields.green_strain = sim.model().green_strains(sim.positions());
   const VectorXd loads = criteria_loads(sim);
   CutState state{*m_tree,           flat,       sim.positions(),  fields,          loads,
                  sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
@@ -544,6 +547,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const bool within_tolerance =
       m_estimates_error && m_estimate.relative_error <= m_settings.tolerance;
   if (!coarsen && (!refine || within_tolerance)) return {};
+  fields = sim.model().tet_fields(sim.positions());
   m_decision_merges = coarsen;
   CutChanges changes = m_controller->decide(state, *m_cut);
   if (!refine || within_tolerance) {

@@ -208,6 +208,24 @@ TEST_P(ElasticModelTest, PatchTestLinearFieldGivesConstantStrainAndNoInteriorFor
   }
 }
 
+TEST_P(ElasticModelTest, GreenStrainsAloneAreThoseOfTheFieldsAndOfTheAffineMap) {
+  const TetMesh mesh = irregular_box(4, 8);
+  const ElasticModel model(mesh.vertices, mesh.tets, test_material(GetParam()));
+  std::mt19937 rng(11);
+  const Matrix3d A = random_deformation_gradient(rng, 0.2);
+  VectorXd x(model.num_dofs());
+  for (Index v = 0; v < model.num_vertices(); ++v)
+    x.segment<3>(3 * v) = A * mesh.vertices.row(v).transpose() + Vector3d(0.3, 0.1, -0.2);
+  const Eigen::Matrix<double, Eigen::Dynamic, 6> strains = model.green_strains(x);
+  EXPECT_EQ(strains, model.tet_fields(x).green_strain);  // the same bits
+  // E = ½ (AᵀA − I), Voigt [xx yy zz xy yz xz] of the tensor components.
+  const Matrix3d E = 0.5 * (A.transpose() * A - Matrix3d::Identity());
+  Eigen::Matrix<double, 1, 6> expected;
+  expected << E(0, 0), E(1, 1), E(2, 2), E(0, 1), E(1, 2), E(0, 2);
+  for (Index t = 0; t < model.num_tets(); ++t)
+    EXPECT_LT((strains.row(t) - expected).norm(), 1e-12 * expected.norm()) << "tet " << t;
+}
+
 INSTANTIATE_TEST_SUITE_P(AllModels, ElasticModelTest, ::testing::ValuesIn(kAllModels),
                          [](const auto& info) { return to_string(info.param); });
 

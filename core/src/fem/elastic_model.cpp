@@ -496,10 +496,21 @@ std::pair<double, Index> ElasticModel::min_volume_ratio(ConstRef<VectorXd> x) co
   return {smallest.J, smallest.tet};
 }
 
+Eigen::Matrix<double, Eigen::Dynamic, 6> ElasticModel::green_strains(ConstRef<VectorXd> x) const {
+  check_size(x, num_dofs());
+  Eigen::Matrix<double, Eigen::Dynamic, 6> strains(num_tets(), 6);
+  tbb::parallel_for(Index(0), num_tets(), [&](Index t) {
+    int tet[4] = {m_tets(t, 0), m_tets(t, 1), m_tets(t, 2), m_tets(t, 3)};
+    const Matrix3d F = edge_matrix_at(x.data(), tet) * m_rest.Dm_inv[t];
+    strains.row(t) = to_voigt(green_strain(F)).transpose();
+  });
+  return strains;
+}
+
 TetFields ElasticModel::tet_fields(ConstRef<VectorXd> x) const {
   check_size(x, num_dofs());
   TetFields fields;
-  fields.green_strain.resize(num_tets(), 6);
+  fields.green_strain = green_strains(x);  // the same bits as green_strains alone
   fields.cauchy_stress.resize(num_tets(), 6);
   fields.von_mises.resize(num_tets());
   tbb::parallel_for(Index(0), num_tets(), [&](Index t) {
@@ -507,7 +518,6 @@ TetFields ElasticModel::tet_fields(ConstRef<VectorXd> x) const {
     const Matrix3d F = edge_matrix_at(x.data(), tet) * m_rest.Dm_inv[t];
     const Matrix3d Fe = m_plastic_inverse.empty() ? F : Matrix3d(F * m_plastic_inverse[t]);
     const Matrix3d sigma = cauchy_stress(dpsi_dF(m_material.model, Fe, m_lame), Fe);
-    fields.green_strain.row(t) = to_voigt(green_strain(F)).transpose();
     fields.cauchy_stress.row(t) = to_voigt(sigma).transpose();
     fields.von_mises[t] = von_mises_stress(sigma);
   });

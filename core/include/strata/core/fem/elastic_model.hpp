@@ -82,6 +82,9 @@ class ElasticModel {
   /// Green strain of the total F, and the Cauchy and von Mises stress of the elastic part
   /// Fₑ = F Fₚ⁻¹, per tet.
   TetFields tet_fields(ConstRef<VectorXd> x) const;
+  /// The Green strain of the total F per tet (#T × 6 Voigt), as in tet_fields, without the
+  /// stresses. Parallel.
+  Eigen::Matrix<double, Eigen::Dynamic, 6> green_strains(ConstRef<VectorXd> x) const;
 
   /// Plastic deformation per tet (plasticity.hpp): every tet's energy becomes V ψ(F Fₚ⁻¹), i.e.
   /// Dm⁻¹ is replaced by Dm⁻¹ Fₚ⁻¹ in every kernel. `plastic_inverse`: Fₚ⁻¹ per tet (#T, each with
