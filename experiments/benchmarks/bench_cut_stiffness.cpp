@@ -62,6 +62,18 @@ const GradedCut& graded_cut() {
   return graded;
 }
 
+/// The mesh model of the graded cut and the reduced one on its free vertices (which points to the
+/// mesh model: not copied).
+struct CutModels {
+  explicit CutModels(const GradedCut& g)
+      : model(g.cut->flat.mesh.vertices, g.cut->flat.mesh.tets, g.material),
+        embedded(model, g.cut->constraints.matrix(), g.cut->constraints.free_vertices()) {}
+  CutModels(const CutModels&) = delete;
+  CutModels& operator=(const CutModels&) = delete;
+  ElasticModel model;
+  EmbeddedElasticModel embedded;
+};
+
 void set_cut_counters(benchmark::State& state, const GradedCut& g,
                       const EmbeddedElasticModel& embedded) {
   state.counters["tets"] = double(g.cut->flat.mesh.tets.rows());
@@ -73,17 +85,12 @@ void set_cut_counters(benchmark::State& state, const GradedCut& g,
 void build_benchmark(benchmark::State& state, int threads) {
   const ThreadLimit limit(threads);
   const GradedCut& g = graded_cut();
-  const TetMesh& mesh = g.cut->flat.mesh;
   for (auto _ : state) {
-    const ElasticModel model(mesh.vertices, mesh.tets, g.material);
-    const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
-                                        g.cut->constraints.free_vertices());
-    benchmark::DoNotOptimize(embedded.stiffness_pattern().nonZeros());
+    const CutModels models(g);
+    benchmark::DoNotOptimize(models.embedded.stiffness_pattern().nonZeros());
   }
-  const ElasticModel model(mesh.vertices, mesh.tets, g.material);
-  const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
-                                      g.cut->constraints.free_vertices());
-  set_cut_counters(state, g, embedded);
+  const CutModels models(g);
+  set_cut_counters(state, g, models.embedded);
 }
 
 /// A smooth bend of the free vertices: every element strained, none inverted.
@@ -100,10 +107,9 @@ VectorXd bent_state(const EmbeddedElasticModel& embedded) {
 void assemble_benchmark(benchmark::State& state, bool project_psd, int threads) {
   const ThreadLimit limit(threads);
   const GradedCut& g = graded_cut();
-  const TetMesh& mesh = g.cut->flat.mesh;
-  const ElasticModel model(mesh.vertices, mesh.tets, g.material);
-  const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
-                                      g.cut->constraints.free_vertices());
+  const CutModels models(g);
+  const ElasticModel& model = models.model;
+  const EmbeddedElasticModel& embedded = models.embedded;
   const VectorXd q = bent_state(embedded);
   SparseMatrixd K;
   embedded.stiffness(q, K, project_psd);  // sets the pattern, outside the timing
@@ -119,10 +125,10 @@ void assemble_benchmark(benchmark::State& state, bool project_psd, int threads) 
 void estimate_benchmark(benchmark::State& state, bool strains_only, int threads) {
   const ThreadLimit limit(threads);
   const GradedCut& g = graded_cut();
+  const CutModels models(g);
+  const ElasticModel& model = models.model;
+  const EmbeddedElasticModel& embedded = models.embedded;
   const TetMesh& mesh = g.cut->flat.mesh;
-  const ElasticModel model(mesh.vertices, mesh.tets, g.material);
-  const EmbeddedElasticModel embedded(model, g.cut->constraints.matrix(),
-                                      g.cut->constraints.free_vertices());
   const VectorXd x = embedded.expand(bent_state(embedded));
   const VectorXd loads = VectorXd::Zero(x.size());
   const VectorXd mass = VectorXd::Zero(mesh.vertices.rows());
