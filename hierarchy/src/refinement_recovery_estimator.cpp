@@ -203,6 +203,15 @@ BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimat
   std::vector<int> node_tet(static_cast<std::size_t>(tree.pool_size()), -1);
   for (Index t = 0; t < num_tets; ++t)
     node_tet[flat.tet_nodes[t]] = static_cast<int>(t);
+  const bool upper_only = estimate.upper_only;
+  const double z_scale = kDisplacementPerEnergyError * kDisplacementPerEnergyError / reference;
+  double z_sq = estimate.upper_error * estimate.upper_error / z_scale;  // Σ terms of z² [J]
+  double c = estimate.load_work_error * reference;                      // Σ terms of c [J]
+  // The estimate after the merges kept so far plus rises (dz, dc).
+  const auto predicted = [&](double dz, double dc) {
+    const double z = std::sqrt(std::max(0.0, (z_sq + dz) * z_scale));
+    return upper_only ? z : std::sqrt(z * std::max(0.0, (c + dc) / reference));
+  };
   const int depth = tree.max_level();
   const auto z_share = [&](int level) {
     const double removed = displacement_share_removed(depth, level);
@@ -210,8 +219,9 @@ BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimat
   };
   struct Merge {
     NodeId parent;
-    double dz;  // rise of z² ‖u‖² [J]
-    double dc;  // rise of c ‖u‖² [J]
+    double dz;     // rise of z² ‖u‖² [J]
+    double dc;     // rise of c ‖u‖² [J]
+    double alone;  // the estimate after this merge alone
   };
   std::vector<Merge> merges;
   merges.reserve(parents.size());
@@ -225,33 +235,17 @@ BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimat
     }
     const int level = tree.level(parent);
     const double parent_sq = std::max(4.0 * children_sq, children_sq + merge_loss(state, children));
-    merges.push_back({parent, parent_sq * z_share(level) - children_sq * z_share(level + 1),
-                      parent_sq * energy_share_removed(depth, level) -
-                          children_sq * energy_share_removed(depth, level + 1)});
+    const double dz = parent_sq * z_share(level) - children_sq * z_share(level + 1);
+    const double dc = parent_sq * energy_share_removed(depth, level) -
+                      children_sq * energy_share_removed(depth, level + 1);
+    merges.push_back({parent, dz, dc, predicted(dz, dc)});
   }
-  const bool upper_only = estimate.upper_only;
-  const double z_scale = kDisplacementPerEnergyError * kDisplacementPerEnergyError / reference;
-  double z_sq = estimate.upper_error * estimate.upper_error / z_scale;  // Σ terms of z² [J]
-  double c = estimate.load_work_error * reference;                      // Σ terms of c [J]
-  // The estimate after the merges so far plus rises (dz, dc).
-  const auto predicted = [&](double dz, double dc) {
-    const double z = std::sqrt(std::max(0.0, (z_sq + dz) * z_scale));
-    return upper_only ? z : std::sqrt(z * std::max(0.0, (c + dc) / reference));
-  };
-  // Cheapest first: each merge by the estimate it alone would leave.
-  std::vector<double> alone(merges.size());
-  for (std::size_t i = 0; i < merges.size(); ++i)
-    alone[i] = predicted(merges[i].dz, merges[i].dc);
-  std::vector<std::size_t> order(merges.size());
-  for (std::size_t i = 0; i < order.size(); ++i)
-    order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return alone[a] != alone[b] ? alone[a] < alone[b] : merges[a].parent < merges[b].parent;
+  // Cheapest first; every merge that still fits is kept: one that does not may leave room for a
+  // later one that raises the other bracket less.
+  std::sort(merges.begin(), merges.end(), [](const Merge& a, const Merge& b) {
+    return a.alone != b.alone ? a.alone < b.alone : a.parent < b.parent;
   });
-  // Every merge that still fits: one that does not may leave room for a later one that raises
-  // the other bracket less.
-  for (const std::size_t i : order) {
-    const Merge& merge = merges[i];
+  for (const Merge& merge : merges) {
     const double after = predicted(merge.dz, merge.dc);
     if (after > budget) continue;
     z_sq += merge.dz;

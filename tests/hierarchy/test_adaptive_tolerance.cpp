@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -340,33 +341,27 @@ TEST(AdaptiveTolerance, CoarseningKeepsTheEstimateWithinTheTolerance) {
     EXPECT_LE(sample.estimated_error, h.tolerance) << "step " << sample.step;
 }
 
-TEST(AdaptiveTolerance, CoarsenBudgetOutsideItsRangeIsRefused) {
-  for (double budget : {0.0, -0.5, 1.5}) {
+/// Values outside (0, 1] set by `set` are refused with an error naming hierarchy.`key`.
+void expect_fraction_refused(const std::string& key,
+                             const std::function<void(HierarchySettings&, double)>& set) {
+  for (double value : {0.0, -0.5, 1.5}) {
     HierarchySettings h = defaults(2);
-    h.coarsen_budget = budget;
+    set(h, value);
     try {
       validate_hierarchy_settings(h, "hierarchy");
-      ADD_FAILURE() << "accepted " << budget;
+      ADD_FAILURE() << key << ": accepted " << value;
     } catch (const InputError& error) {
-      EXPECT_NE(std::string(error.what()).find("hierarchy.coarsen_budget"), std::string::npos)
+      EXPECT_NE(std::string(error.what()).find("hierarchy." + key), std::string::npos)
           << error.what();
     }
   }
 }
 
-TEST(AdaptiveTolerance, FullResolutionFractionOutsideItsRangeIsRefused) {
-  for (double fraction : {0.0, -0.5, 1.5}) {
-    HierarchySettings h = defaults(2);
-    h.full_resolution_fraction = fraction;
-    try {
-      validate_hierarchy_settings(h, "hierarchy");
-      ADD_FAILURE() << "accepted " << fraction;
-    } catch (const InputError& error) {
-      EXPECT_NE(std::string(error.what()).find("hierarchy.full_resolution_fraction"),
-                std::string::npos)
-          << error.what();
-    }
-  }
+TEST(AdaptiveTolerance, FractionsOutsideTheirRangeAreRefused) {
+  expect_fraction_refused("coarsen_budget",
+                          [](HierarchySettings& h, double v) { h.coarsen_budget = v; });
+  expect_fraction_refused("full_resolution_fraction",
+                          [](HierarchySettings& h, double v) { h.full_resolution_fraction = v; });
 }
 
 }  // namespace

@@ -99,8 +99,8 @@ struct HierarchySettings {
   double full_resolution_fraction = 0.85;
   /// With the recovery estimate (an error-estimating indicator): the merges of one change are
   /// kept to those whose predicted estimate stays within coarsen_budget · tolerance
-  /// (merges_within_budget, smallest predicted rise first), so that coarsening alone does not lift
-  /// the run over its tolerance; ∈ (0, 1].
+  /// (merges_within_budget), so that coarsening alone does not lift the run over its tolerance;
+  /// ∈ (0, 1].
   double coarsen_budget = 0.8;
   /// `criteria.refine_threshold` was given explicitly (an expert override of the tolerance rule).
   bool refine_threshold_set = false;

@@ -40,9 +40,9 @@
 ///
 /// (for plastic materials e = z: the identity behind c holds for elastic states only, and a
 /// plastic zone formed on a coarse cut stays in the run's history). Its effectivity (e / true
-/// error) was 1.3–2.4 on the adaptive runs of the project's local-load and cantilever scenes,
-/// 3.2–3.6 on the column and the armadillo (probes away from where the error is) and 0.57–2.5 on
-/// most uniform cuts (README, "Error control"). e is the estimated error of the run in the
+/// error) was 1.2–2.4 on the adaptive runs of the project's local-load and cantilever scenes,
+/// 2.8 on the column and 3.6 on the armadillo (probes away from where the error is) and 0.57–2.5
+/// on most uniform cuts (README, "Error control"). e is the estimated error of the run in the
 /// measure hierarchy.tolerance bounds. It is zero for affine fields and uniform strain, grows
 /// with strain jumps between neighbours (bending on coarse tets, concentrated loads), and is zero
 /// on the finest level.
