@@ -214,5 +214,49 @@ TEST(EnergyTerms, SumHessianIsBitForBitAZeroFillAndTheTermsAddedInOrder) {
   EXPECT_FALSE(damping.set_hessian(f.state, set, false));  // a term that only adds
 }
 
+TEST(EnergyTerms, DiagonalPositionsAddWhatAddDiagonalAddsAndFollowThePattern) {
+  // The cached positions give the values of the searching add_diagonal, bit for bit, on the
+  // pattern they were found in and again on another pattern handed to the same object.
+  TermFixture f(MaterialModel::neohookean);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uniform(0.5, 2.0);
+  DiagonalPositions positions;
+  for (int round = 0; round < 2; ++round) {
+    // Round 0: the model's pattern; round 1: a tridiagonal pattern of another size.
+    SparseMatrixd pattern = f.embedded->stiffness_pattern();
+    if (round == 1) {
+      const Index n = pattern.rows() + 5;
+      std::vector<Eigen::Triplet<double>> triplets;
+      for (Index i = 0; i < n; ++i)
+        for (Index j = std::max<Index>(0, i - 1); j <= std::min(n - 1, i + 1); ++j)
+          triplets.emplace_back(i, j, 1.0);
+      pattern.resize(n, n);
+      pattern.setFromTriplets(triplets.begin(), triplets.end());
+    }
+    for (Index k = 0; k < pattern.nonZeros(); ++k)
+      pattern.valuePtr()[k] = uniform(rng);
+    VectorXd weights(pattern.rows());
+    for (Index i = 0; i < weights.size(); ++i)
+      weights[i] = uniform(rng);
+    const double scale = 1.0 / 3.0;
+    SparseMatrixd expected = pattern;
+    add_diagonal(scale * weights, expected);
+    for (int use = 0; use < 2; ++use) {  // the second use reads the cached positions
+      SparseMatrixd added = pattern;
+      positions.add(scale, weights, added);
+      EXPECT_TRUE(std::equal(expected.valuePtr(), expected.valuePtr() + expected.nonZeros(),
+                             added.valuePtr()))
+          << "round " << round << ", use " << use;
+    }
+  }
+  // A pattern without a full diagonal is refused.
+  SparseMatrixd off_diagonal(2, 2);
+  off_diagonal.insert(0, 1) = 1.0;
+  off_diagonal.insert(1, 0) = 1.0;
+  off_diagonal.makeCompressed();
+  DiagonalPositions fresh;
+  EXPECT_ANY_THROW(fresh.add(1.0, VectorXd::Ones(2), off_diagonal));
+}
+
 }  // namespace
 }  // namespace strata

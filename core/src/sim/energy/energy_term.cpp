@@ -68,4 +68,31 @@ void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target) {
   }
 }
 
+void DiagonalPositions::add(double scale, ConstRef<VectorXd> weights, SparseMatrixd& target) {
+  STRATA_VERIFY(weights.size() == target.rows() && target.isCompressed(),
+                "DiagonalPositions::add: size mismatch or uncompressed matrix");
+  if (target.outerIndexPtr() != m_outer || target.innerIndexPtr() != m_inner ||
+      target.rows() != m_size || target.nonZeros() != m_non_zeros) {
+    m_positions.resize(target.outerSize());
+    for (Index i = 0; i < target.outerSize(); ++i) {
+      const int* begin = target.innerIndexPtr() + target.outerIndexPtr()[i];
+      const int* end = target.innerIndexPtr() + target.outerIndexPtr()[i + 1];
+      const int* found = std::lower_bound(begin, end, static_cast<int>(i));
+      STRATA_VERIFY(found != end && *found == i,
+                    "DiagonalPositions::add: pattern lacks a diagonal entry");
+      m_positions[i] = found - target.innerIndexPtr();
+    }
+    m_outer = target.outerIndexPtr();
+    m_inner = target.innerIndexPtr();
+    m_size = target.rows();
+    m_non_zeros = target.nonZeros();
+  }
+  // The products are rounded before the sums (no fused multiply-add): the values are those of
+  // add_diagonal, and a term's additions commute with the other terms' as EnergySum assumes.
+  m_scaled = scale * weights;
+  double* values = target.valuePtr();
+  for (Index i = 0; i < m_size; ++i)
+    values[m_positions[i]] += m_scaled[i];
+}
+
 }  // namespace strata

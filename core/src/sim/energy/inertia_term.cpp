@@ -20,7 +20,7 @@ void InertiaTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient) const {
 }
 
 void InertiaTerm::add_hessian(ConstRef<VectorXd>, SparseMatrixd& hessian, bool) const {
-  add_diagonal(m_mass * m_inverse_h2, hessian);
+  m_diagonal.add(m_inverse_h2, m_mass, hessian);
 }
 
 }  // namespace strata

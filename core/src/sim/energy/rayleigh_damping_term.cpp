@@ -33,7 +33,7 @@ void RayleighDampingTerm::add_gradient(ConstRef<VectorXd> q, VectorXd& gradient)
 }
 
 void RayleighDampingTerm::add_hessian(ConstRef<VectorXd>, SparseMatrixd& hessian, bool) const {
-  if (m_alpha > 0.0) add_diagonal(m_mass * (m_alpha / m_h), hessian);
+  if (m_alpha > 0.0) m_diagonal.add(m_alpha / m_h, m_mass, hessian);
   if (m_beta > 0.0) add_values_same_pattern(m_start_stiffness, m_beta / m_h, hessian);
 }
 

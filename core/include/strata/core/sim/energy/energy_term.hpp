@@ -83,4 +83,22 @@ void add_values_same_pattern(const SparseMatrixd& source, double scale, SparseMa
 /// diagonal.
 void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target);
 
+/// The positions of a pattern's diagonal entries in its values, for terms that add to the
+/// diagonal of every Hessian of a Problem (one pattern): found on first use and again only when
+/// the matrix has another pattern (other size, non-zero count or index arrays).
+class DiagonalPositions {
+ public:
+  /// Adds `scale · weights[i]` to entry (i, i) of `target`, whose pattern must hold the diagonal;
+  /// the same values as add_diagonal(scale * weights, target).
+  void add(double scale, ConstRef<VectorXd> weights, SparseMatrixd& target);
+
+ private:
+  std::vector<Index> m_positions;
+  VectorXd m_scaled;
+  const int* m_outer = nullptr;
+  const int* m_inner = nullptr;
+  Index m_size = -1;
+  Index m_non_zeros = -1;
+};
+
 }  // namespace strata

@@ -21,6 +21,7 @@ class InertiaTerm final : public EnergyTerm {
   const VectorXd& m_mass;
   VectorXd m_predicted;
   double m_inverse_h2 = 0.0;
+  mutable DiagonalPositions m_diagonal;
 };
 
 }  // namespace strata

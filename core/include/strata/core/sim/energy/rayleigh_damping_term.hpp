@@ -30,6 +30,7 @@ class RayleighDampingTerm final : public EnergyTerm {
   double m_h = 1.0;
   VectorXd m_start;
   SparseMatrixd m_start_stiffness;  ///< Kₙ (projected), the model's pattern
+  mutable DiagonalPositions m_diagonal;
 };
 
 }  // namespace strata
