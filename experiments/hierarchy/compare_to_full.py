@@ -7,10 +7,14 @@ error of a run is the largest probe-displacement difference to the full run over
 probe, relative to the largest full-resolution probe displacement (the measure hierarchy.tolerance
 bounds). Prints one line per run and writes <out>/compare.json:
 
-  compare_to_full.py SCENE.json [--out DIR] [--strata PATH]
+  compare_to_full.py SCENE.json [--out DIR] [--strata PATH] [--field]
                      [--run adaptive:] [--run tight:tolerance=0.005] [--set key=value ...]
 
 `--set` applies to every run (full included), e.g. --set solver.duration=0.1.
+`--field` also measures the field error (field_error.py: the displacement difference at every
+vertex of the full mesh in every frame, relative to the largest full-resolution displacement) and
+the effectivity against it; each run is repeated with its .vtu frames written, untimed, so that
+writing them does not enter the speed-ups.
 """
 import argparse
 import csv
@@ -32,15 +36,17 @@ def read_probes(folder):
     return frames
 
 
-def run(args, name, settings):
-    folder = os.path.join(args.out, name)
+def run(args, name, settings, frames=False):
+    folder = os.path.join(args.out, name + ("-frames" if frames else ""))
     stats_path = os.path.join(folder, "stats.json")
     command = [args.strata, "run", args.scene, "--out", folder, "--quiet",
-               "--set", "output.vtk=false"]
+               "--set", f"output.vtk={'true' if frames else 'false'}"]
     for item in args.set:
         command += ["--set", item]
     for key, value in settings.items():
         command += ["--set", f"hierarchy.{key}={value}"]
+    if frames:
+        command += ["--set", "output.vtk_encoding=binary"]
     if name == "full" and os.path.exists(stats_path) and not args.rerun_full:
         return json.load(open(stats_path)), folder
     start = time.monotonic()
@@ -61,9 +67,13 @@ def main():
     parser.add_argument("--run", action="append", default=[])
     parser.add_argument("--set", action="append", default=[])
     parser.add_argument("--rerun-full", action="store_true")
+    parser.add_argument("--field", action="store_true")
     args = parser.parse_args()
     runs = args.run or ["adaptive:"]
     full_stats, full_folder = run(args, "full", {"mode": "full"})
+    if args.field:
+        import field_error  # needs numpy: only with --field
+        full_frames = run(args, "full", {"mode": "full"}, frames=True)[1]
     reference = read_probes(full_folder)
     scale = max(sum(c * c for c in u) ** 0.5 for u in reference.values())
     report = {"scene": args.scene, "full": {"wall_seconds": full_stats["wall_seconds"],
@@ -94,6 +104,15 @@ def main():
                  "final_tets": stats["tets"], "max_tets": max(history) if history else None,
                  "estimated_error": h.get("estimated_error"),
                  "redone_steps": h.get("redone_steps")}
+        if args.field:
+            field = field_error.field_error(full_frames, run(args, name, settings, True)[1])
+            entry["field_error"] = field["error"]
+            entry["field_worst_time"] = field["worst_time"]
+            estimated = entry["estimated_error"]
+            entry["field_effectivity"] = (estimated / field["error"]
+                                          if estimated is not None and field["error"] > 0 else None)
+            print(f"{name}: field error {100 * field['error']:.3f} % (t = {field['worst_time']}), "
+                  f"effectivity {entry['field_effectivity']}")
         report["runs"].append(entry)
         print(f"{name}: error {100 * entry['error']:.2f} % (last frame "
               f"{100 * entry['error_last_frame']:.2f} %), {entry['wall_seconds']:.2f} s "
