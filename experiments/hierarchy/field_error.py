@@ -100,11 +100,12 @@ def locate(points, vertices, tets):
 
 
 def field_error(full_folder, run_folder):
-    """{"error", "worst_time", "worst_outside", "scale"} of the run against the full one."""
+    """{"error", "worst_time", "worst_outside", "scale", "frames"} of the run against the full
+    one; "frames" lists (time, error) per frame, relative to the same scale."""
     reference, run = frames(full_folder), frames(run_folder)
     if [t for t, _ in reference] != [t for t, _ in run]:
         raise ValueError(f"{run_folder}: its frame times differ from {full_folder}'s")
-    worst, worst_time, scale, outside = 0.0, None, 0.0, 0.0
+    worst, worst_time, scale, outside, per_frame = 0.0, None, 0.0, 0.0, []
     for (time, full_path), (_, run_path) in zip(reference, run):
         full_rest, full_u, _ = read_frame(full_path)
         rest, u, tets = read_frame(run_path)
@@ -113,10 +114,12 @@ def field_error(full_folder, run_folder):
         interpolated = np.einsum("pk,pkc->pc", weights, u[tets[tet]])
         difference = np.linalg.norm(interpolated - full_u, axis=1).max()
         scale = max(scale, np.linalg.norm(full_u, axis=1).max())
+        per_frame.append((time, difference))
         if difference > worst:
             worst, worst_time = difference, time
-    return {"error": worst / scale if scale > 0 else 0.0, "worst_time": worst_time,
-            "scale": scale, "worst_outside": outside}
+    relative = (lambda d: d / scale) if scale > 0 else (lambda d: 0.0)
+    return {"error": relative(worst), "worst_time": worst_time, "scale": scale,
+            "worst_outside": outside, "frames": [(t, relative(d)) for t, d in per_frame]}
 
 
 def main():
