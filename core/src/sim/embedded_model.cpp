@@ -199,7 +199,10 @@ void EmbeddedElasticModel::build_reduced_pattern() {
         });
   }
   const CompressedLists& blocks = block_lists;
-  m_pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
+  {
+    SparseMatrixd pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
+    m_pattern.swap(pattern);  // Eigen's assignment from a named matrix would copy it
+  }
 
   // A mesh vertex whose C row is e_q for its own DOF vertex q is direct. Distinct direct vertices
   // have distinct DOF vertices, so tets of direct vertices that share no vertex share no target.

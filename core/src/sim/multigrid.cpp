@@ -246,7 +246,8 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   m_levels[L]->A = &A;
   m_levels[L]->owned.resize(0, 0);
   for (int k = L - 1; k >= 0; --k) {
-    m_levels[k]->owned = galerkin_product(*m_levels[k + 1]->A, m_prolongations[k]);
+    SparseMatrixd coarse = galerkin_product(*m_levels[k + 1]->A, m_prolongations[k]);
+    m_levels[k]->owned.swap(coarse);  // Eigen's assignment from a named matrix would copy it
     m_levels[k]->A = &m_levels[k]->owned;
   }
   for (int k = 1; k <= L; ++k)
