@@ -96,7 +96,7 @@ struct HierarchySettings {
   /// vertices, estimates, redone steps and cut changes; README, "Error control"). 1: never.
   /// Not with explicit integrators, an element budget below the finest level, or max_level below
   /// the tree's depth.
-  double full_resolution_fraction = 0.85;
+  double full_resolution_fraction = 0.75;
   /// With the recovery estimate (an error-estimating indicator): the merges of one change are
   /// kept to those whose predicted estimate stays within coarsen_budget · tolerance
   /// (merges_within_budget), so that coarsening alone does not lift the run over its tolerance;
