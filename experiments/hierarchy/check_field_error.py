@@ -3,8 +3,9 @@
 
   check_field_error.py STRATA WORK_DIR
 
-1. Point location: random points in a Freudenthal-split box mesh are located in a tet that holds
-   them (barycentric coordinates ≥ −1e-12 that reproduce the point to 1e-12).
+1. Point location: random points in Freudenthal-split box meshes, one uniform and one graded
+   (cells from 1 % to 37 % of the box, so large tets span many grid cells), are located in a tet
+   that holds them (barycentric coordinates ≥ −1e-12 that reproduce the point to 1e-12).
 2. A small struck block run at full resolution (1 level) and on its roots (uniform level 0),
    frames written: the field error equals the one computed point by point, each full vertex
    located by testing every root tet, to 1e-10 relative; it is positive, and a run against itself
@@ -26,12 +27,17 @@ def fail(message):
     sys.exit(f"check_field_error: {message}")
 
 
-def box_mesh(cells):
-    """Vertices and tets of the unit box split into cells, each cell into 6 tets around a diagonal."""
+def box_mesh(cells, graded=False):
+    """Vertices and tets of the unit box split into cells, each cell into 6 tets around a diagonal;
+    graded: the cells' widths along each axis double from one cell to the next."""
     nx, ny, nz = cells
-    grid = np.stack(np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), np.arange(nz + 1),
-                                indexing="ij"), axis=-1).reshape(-1, 3)
-    vertices = grid / np.array(cells, dtype=float)
+
+    def nodes(n):
+        widths = 2.0 ** np.arange(n) if graded else np.ones(n)
+        return np.concatenate([[0.0], np.cumsum(widths)]) / widths.sum()
+
+    xs, ys, zs = nodes(nx), nodes(ny), nodes(nz)
+    vertices = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
     index = lambda i, j, k: (i * (ny + 1) + j) * (nz + 1) + k  # noqa: E731
     paths = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
     tets = []
@@ -49,23 +55,29 @@ def box_mesh(cells):
 
 
 def check_locate():
-    vertices, tets = box_mesh((5, 4, 3))
     rng = np.random.default_rng(7)
-    points = rng.random((4000, 3))
-    points = np.concatenate([points, vertices])  # vertices sit on many tets' corners
-    tet, weights, score = field_error.locate(points, vertices, tets)
-    if score.min() < -1e-12:
-        fail(f"locate: a point lies outside its tet by {-score.min():.3g}")
-    rebuilt = np.einsum("pk,pkc->pc", weights, vertices[tets[tet]])
-    error = np.abs(rebuilt - points).max()
-    if error > 1e-12:
-        fail(f"locate: barycentric coordinates reproduce the points to {error:.3g} only")
+    for graded in (False, True):
+        vertices, tets = box_mesh((6, 5, 4), graded)
+        points = rng.random((4000, 3))
+        points = np.concatenate([points, vertices])  # vertices sit on many tets' corners
+        tet, weights, score = field_error.locate(points, vertices, tets)
+        if score.min() < -1e-12:
+            fail(f"locate (graded {graded}): a point lies outside its tet by {-score.min():.3g}")
+        rebuilt = np.einsum("pk,pkc->pc", weights, vertices[tets[tet]])
+        error = np.abs(rebuilt - points).max()
+        if error > 1e-12:
+            fail(f"locate (graded {graded}): barycentric coordinates reproduce the points to "
+                 f"{error:.3g} only")
 
 
 def brute_force_error(full_folder, run_folder):
     worst, scale = 0.0, 0.0
-    for (_, full_path), (_, run_path) in zip(field_error.frames(full_folder),
-                                             field_error.frames(run_folder)):
+    full_frames, run_frames = field_error.frames(full_folder), field_error.frames(run_folder)
+    if len(full_frames) != len(run_frames) or len(full_frames) < 3:
+        fail(f"expected the same frames (at least 3), got {len(full_frames)} and {len(run_frames)}")
+    for (full_time, full_path), (run_time, run_path) in zip(full_frames, run_frames):
+        if full_time != run_time:
+            fail(f"frame times differ: {full_time} and {run_time}")
         full_rest, full_u, _ = field_error.read_frame(full_path)
         rest, u, tets = field_error.read_frame(run_path)
         for p, x in enumerate(full_rest):

@@ -51,12 +51,14 @@ def read_frame(path):
 def locate(points, vertices, tets):
     """For each point, a tet that holds it and its barycentric coordinates.
 
-    Tets are bucketed on a grid of cells as large as the smallest tet's longest edge; a point is
-    tested against the tets of its cell, and the one where its smallest barycentric coordinate is
-    largest is kept (inside up to rounding for points in the mesh)."""
+    Tets are bucketed on a grid of cells as large as the median tet's longest edge, each into
+    every cell its bounding box (padded by 1e-9 of the mesh's extent, for points on its faces)
+    touches; a point is tested against the tets of its cell, and the one where its smallest
+    barycentric coordinate is largest is kept (inside up to rounding for points in the mesh)."""
     corners = vertices[tets]                                   # m × 4 × 3
-    low, high = corners.min(axis=1), corners.max(axis=1)
-    size = max((high - low).max(axis=1).min(), 1e-12)
+    pad = 1e-9 * np.ptp(vertices, axis=0).max()
+    low, high = corners.min(axis=1) - pad, corners.max(axis=1) + pad
+    size = max(float(np.median((high - low).max(axis=1))), 1e-12)
     origin = np.minimum(vertices.min(axis=0), points.min(axis=0)) - 1e-9
     shape = np.floor((np.maximum(vertices.max(axis=0), points.max(axis=0)) - origin) / size)
     shape = shape.astype(np.int64) + 1

@@ -249,13 +249,47 @@ TEST(EnergyTerms, DiagonalPositionsAddWhatAddDiagonalAddsAndFollowThePattern) {
           << "round " << round << ", use " << use;
     }
   }
-  // A pattern without a full diagonal is refused.
+  // The same matrix object rewritten with another pattern of the same size and non-zero count
+  // (upper bidiagonal, then the diagonal with a full first column: the diagonal entries of
+  // columns 1–6 move from 2j to 6 + j): the positions follow.
+  const auto pattern_of = [](Index n, bool bidiagonal) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (Index i = 0; i < n; ++i) {
+      triplets.emplace_back(i, i, 1.0 + i);
+      if (bidiagonal && i + 1 < n) triplets.emplace_back(i, i + 1, 0.5);
+      if (!bidiagonal && i > 0) triplets.emplace_back(i, 0, 0.5);
+    }
+    SparseMatrixd m(n, n);
+    m.setFromTriplets(triplets.begin(), triplets.end());
+    return m;
+  };
+  const SparseMatrixd upper = pattern_of(7, true), lower = pattern_of(7, false);
+  ASSERT_EQ(upper.nonZeros(), lower.nonZeros());
+  SparseMatrixd reused = upper;
+  DiagonalPositions follows;
+  const VectorXd ones = VectorXd::Ones(7);
+  follows.add(1.0, ones, reused);
+  std::copy(lower.outerIndexPtr(), lower.outerIndexPtr() + 8, reused.outerIndexPtr());
+  std::copy(lower.innerIndexPtr(), lower.innerIndexPtr() + lower.nonZeros(),
+            reused.innerIndexPtr());
+  std::copy(lower.valuePtr(), lower.valuePtr() + lower.nonZeros(), reused.valuePtr());
+  follows.add(1.0, ones, reused);
+  SparseMatrixd expected_lower = lower;
+  add_diagonal(ones, expected_lower);
+  EXPECT_TRUE(std::equal(expected_lower.valuePtr(),
+                         expected_lower.valuePtr() + expected_lower.nonZeros(), reused.valuePtr()));
+  // A pattern without a full diagonal is refused, and the positions cached before stay usable.
   SparseMatrixd off_diagonal(2, 2);
   off_diagonal.insert(0, 1) = 1.0;
   off_diagonal.insert(1, 0) = 1.0;
   off_diagonal.makeCompressed();
   DiagonalPositions fresh;
   EXPECT_ANY_THROW(fresh.add(1.0, VectorXd::Ones(2), off_diagonal));
+  EXPECT_ANY_THROW(follows.add(1.0, VectorXd::Ones(2), off_diagonal));
+  SparseMatrixd again = lower;
+  follows.add(1.0, ones, again);
+  EXPECT_TRUE(std::equal(expected_lower.valuePtr(),
+                         expected_lower.valuePtr() + expected_lower.nonZeros(), again.valuePtr()));
 }
 
 }  // namespace

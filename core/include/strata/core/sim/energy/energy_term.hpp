@@ -84,8 +84,9 @@ void add_values_same_pattern(const SparseMatrixd& source, double scale, SparseMa
 void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target);
 
 /// The positions of a pattern's diagonal entries in its values, for terms that add to the
-/// diagonal of every Hessian of a Problem (one pattern): found on first use and again only when
-/// the matrix has another pattern (other size, non-zero count or index arrays).
+/// diagonal of every Hessian of a Problem (one pattern): found on first use and again when the
+/// matrix is another one (other index arrays, size or non-zero count) or its index arrays no
+/// longer hold the diagonal at the cached positions (checked on every use, one read per row).
 class DiagonalPositions {
  public:
   /// Adds `scale · weights[i]` to entry (i, i) of `target`, whose pattern must hold the diagonal;
