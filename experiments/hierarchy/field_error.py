@@ -13,6 +13,7 @@ relative to the largest full-resolution vertex displacement of the run.
 
 Prints the error and the frame where it is largest. Needs numpy (Debian python3-numpy).
 """
+import functools
 import os
 import re
 import sys
@@ -39,6 +40,7 @@ def frames(folder):
     return listed
 
 
+@functools.lru_cache(maxsize=64)  # the full run's frames, read once for all the runs compared
 def read_frame(path):
     """Rest positions, displacements and tets of one .vtu frame (its points are deformed)."""
     frame = vtk_xml.read(path)

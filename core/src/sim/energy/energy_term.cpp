@@ -71,28 +71,25 @@ void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target) {
 void DiagonalPositions::add(double scale, ConstRef<VectorXd> weights, SparseMatrixd& target) {
   STRATA_VERIFY(weights.size() == target.rows() && target.isCompressed(),
                 "DiagonalPositions::add: size mismatch or uncompressed matrix");
-  const int* inner = target.innerIndexPtr();
-  bool cached = target.outerIndexPtr() == m_outer && inner == m_inner && target.rows() == m_size &&
-                target.nonZeros() == m_non_zeros;
-  // The same arrays may hold another pattern of the same size (Eigen reuses them on assignment):
-  // the cached positions must still be the diagonal's.
   const int* outer = target.outerIndexPtr();
+  const int* inner = target.innerIndexPtr();
+  // Kept while they are still the diagonal's in this matrix's index arrays, whichever matrix it
+  // is (Eigen also reuses arrays for another pattern of the same size on assignment).
+  bool cached = target.rows() == m_size && target.nonZeros() == m_non_zeros;
   for (Index i = 0; cached && i < m_size; ++i)
     cached =
         m_positions[i] >= outer[i] && m_positions[i] < outer[i + 1] && inner[m_positions[i]] == i;
   if (!cached) {
     std::vector<Index> positions(target.outerSize());
     for (Index i = 0; i < target.outerSize(); ++i) {
-      const int* begin = inner + target.outerIndexPtr()[i];
-      const int* end = inner + target.outerIndexPtr()[i + 1];
+      const int* begin = inner + outer[i];
+      const int* end = inner + outer[i + 1];
       const int* found = std::lower_bound(begin, end, static_cast<int>(i));
       STRATA_VERIFY(found != end && *found == i,
                     "DiagonalPositions::add: pattern lacks a diagonal entry");
       positions[i] = found - inner;
     }
     m_positions = std::move(positions);  // committed only once the whole diagonal is found
-    m_outer = target.outerIndexPtr();
-    m_inner = target.innerIndexPtr();
     m_size = target.rows();
     m_non_zeros = target.nonZeros();
   }

@@ -85,8 +85,8 @@ void add_diagonal(ConstRef<VectorXd> weights, SparseMatrixd& target);
 
 /// The positions of a pattern's diagonal entries in its values, for terms that add to the
 /// diagonal of every Hessian of a Problem (one pattern): found on first use and again when the
-/// matrix is another one (other index arrays, size or non-zero count) or its index arrays no
-/// longer hold the diagonal at the cached positions (checked on every use, one read per row).
+/// matrix's size or non-zero count differs or its index arrays no longer hold the diagonal at the
+/// cached positions (checked on every use, one read per row).
 class DiagonalPositions {
  public:
   /// Adds `scale · weights[i]` to entry (i, i) of `target`, whose pattern must hold the diagonal;
@@ -96,8 +96,6 @@ class DiagonalPositions {
  private:
   std::vector<Index> m_positions;
   VectorXd m_scaled;
-  const int* m_outer = nullptr;
-  const int* m_inner = nullptr;
   Index m_size = -1;
   Index m_non_zeros = -1;
 };
