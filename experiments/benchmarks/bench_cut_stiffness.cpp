@@ -23,6 +23,7 @@
 #include <strata/core/fem/elastic_model.hpp>
 #include <strata/core/sim/embedded_model.hpp>
 #include <strata/hierarchy/active_cut.hpp>
+#include <strata/hierarchy/cut_levels.hpp>
 #include <strata/hierarchy/cut_state.hpp>
 #include <strata/hierarchy/hanging_constraints.hpp>
 #include <strata/hierarchy/refinement_recovery_estimator.hpp>
@@ -32,6 +33,7 @@ namespace {
 
 struct GradedCut {
   std::unique_ptr<TetTree> tree;
+  std::unique_ptr<ActiveCut> cut_nodes;
   std::unique_ptr<ConstrainedCut> cut;
   Material material;
 };
@@ -53,6 +55,7 @@ const GradedCut& graded_cut() {
         if (nearest < 0.75 - 0.25 * level) cut.refine(n);
       }
     g.cut = std::make_unique<ConstrainedCut>(flatten_cut(cut));
+    g.cut_nodes = std::make_unique<ActiveCut>(std::move(cut));
     g.material.model = MaterialModel::neohookean;
     g.material.youngs_modulus = 1e6;
     g.material.poisson_ratio = 0.45;
@@ -80,6 +83,18 @@ void set_cut_counters(benchmark::State& state, const GradedCut& g,
   state.counters["dofs"] = double(embedded.num_dofs());
   state.counters["hanging"] = double(g.cut->constraints.num_hanging());
   state.counters["nonzeros"] = double(embedded.stiffness_pattern().nonZeros());
+}
+
+void flatten_benchmark(benchmark::State& state, int threads) {
+  const ThreadLimit limit(threads);
+  const GradedCut& g = graded_cut();
+  for (auto _ : state) {
+    const ConstrainedCut cut = flatten_cut(*g.cut_nodes);
+    const NestedSpaces spaces = cut_nested_spaces(*g.tree, cut);
+    benchmark::DoNotOptimize(spaces.num_levels());
+  }
+  const CutModels models(g);
+  set_cut_counters(state, g, models.embedded);
 }
 
 void build_benchmark(benchmark::State& state, int threads) {
@@ -152,6 +167,10 @@ void estimate_benchmark(benchmark::State& state, bool strains_only, int threads)
 const bool registered = [] {
   for (int threads : {1, 2}) {
     const std::string suffix = "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(("cut_stiffness/flatten" + suffix).c_str(), flatten_benchmark,
+                                 threads)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
     benchmark::RegisterBenchmark(("cut_stiffness/build" + suffix).c_str(), build_benchmark, threads)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

@@ -108,15 +108,33 @@ std::vector<HangingVertex> find_hanging_vertices(const TetTree& tree, const Flat
   const auto num_vertices = static_cast<std::size_t>(flat.mesh.vertices.rows());
   STRATA_VERIFY(flat.tree_vertices.size() == num_vertices,
                 "find_hanging_vertices: flat mesh and its vertex map disagree");
+  // A mesh vertex on the boundary of a tet T (not a corner) lies on a refined edge of T; the
+  // active tets of the refined neighbour include, at each end of that edge, one finer than T with
+  // that end as a corner. So a tet none of whose corners belongs to a finer tet has no mesh vertex
+  // on its boundary, and only the others are walked.
+  const auto num_tets = static_cast<Index>(flat.tet_nodes.size());
+  std::vector<int> finest_level(num_vertices, 0);
+  for (Index t = 0; t < num_tets; ++t) {
+    const int level = tree.level(flat.tet_nodes[t]);
+    for (int k = 0; k < 4; ++k) {
+      int& finest = finest_level[flat.mesh.tets(t, k)];
+      finest = std::max(finest, level);
+    }
+  }
+  const auto touches_finer = [&](Index t) {
+    const int level = tree.level(flat.tet_nodes[t]);
+    for (int k = 0; k < 4; ++k)
+      if (finest_level[flat.mesh.tets(t, k)] > level) return true;
+    return false;
+  };
   // Walks in parallel over fixed chunks of tets; a vertex's host is the coarsest tet it lies on,
   // the first in tet order among equals.
-  const auto num_tets = static_cast<Index>(flat.tet_nodes.size());
   const Index num_chunks = std::clamp<Index>(num_tets / 1024, 1, 256);
   std::vector<std::vector<BoundaryWalker::Record>> records(num_chunks);
   tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
     BoundaryWalker walker(tree, flat, records[c]);
     for (Index t = num_tets * c / num_chunks; t < num_tets * (c + 1) / num_chunks; ++t)
-      walker.walk(flat.tet_nodes[t]);
+      if (touches_finer(t)) walker.walk(flat.tet_nodes[t]);
   });
   std::vector<NodeId> host(num_vertices, kNoNode);
   for (const auto& chunk : records)

@@ -2,9 +2,11 @@
 
 #include <Eigen/Eigenvalues>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/fem/lumped_mass.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/simulation.hpp"
@@ -160,6 +162,29 @@ TEST(SimIntegrators, StableStepEstimateIsABoundOnTheTrueLimit) {
   std::printf("omega bound / true = %.3f\n", omega_bound / omega_true);
   EXPECT_NEAR(stable_time_step_estimate(mesh.vertices, mesh.tets, material, Integrator::rk4),
               2.0 * std::sqrt(2.0) / omega_bound, 1e-15 / omega_bound);
+}
+
+TEST(SimIntegrators, MeanEdgeLengthOfKuhnCubes) {
+  // Every tet of a Kuhn-split cube of side h has three edges h, two face diagonals h√2 and one
+  // body diagonal h√3. 40 × 40 × 10 cells: 96,000 tets, many blocks of the parallel sum.
+  const double h = 0.025;
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(1.0, 1.0, 0.25), {40, 40, 10});
+  ASSERT_EQ(mesh.tets.rows(), 96000);
+  const double expected = h * (3.0 + 2.0 * std::sqrt(2.0) + std::sqrt(3.0)) / 6.0;
+  double serial = 0.0, parallel = 0.0;
+  {
+    const ThreadLimit limit(1);
+    serial = mean_edge_length(mesh.vertices, mesh.tets);
+  }
+  {
+    const ThreadLimit limit(2);
+    parallel = mean_edge_length(mesh.vertices, mesh.tets);
+  }
+  // Rounding bound of a sum of 6 · 96,000 terms: n ε relative.
+  const double bound = 6.0 * 96000.0 * std::numeric_limits<double>::epsilon();
+  EXPECT_NEAR(serial, expected, bound * expected);
+  EXPECT_EQ(serial, parallel);  // the same sum for any number of threads
+  EXPECT_EQ(mean_edge_length(mesh.vertices, MatrixX4i(0, 4)), 0.0);
 }
 
 TEST(SimIntegrators, ExplicitIntegratorsAreStableAtTheEstimate) {

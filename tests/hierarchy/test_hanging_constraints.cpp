@@ -97,12 +97,17 @@ TEST(HangingConstraints, DetectionMatchesPointLocation) {
     const MatrixX3d& X = c.flat.mesh.vertices;
     const MatrixX4i& T = c.flat.mesh.tets;
     // Brute force: a vertex hangs iff it lies in the closure of a tet that lacks it as a corner.
+    // Its host: the coarsest such tet, the first in tet order among equals.
     std::vector<char> hangs(static_cast<std::size_t>(X.rows()), 0);
+    std::vector<NodeId> host(static_cast<std::size_t>(X.rows()), kNoNode);
     for (Index t = 0; t < T.rows(); ++t) {
       const Matrix3x4d x = tet_columns(X, T, t);
+      const NodeId node = c.flat.tet_nodes[t];
       for (Index v = 0; v < X.rows(); ++v) {
         if ((T.row(t).array() == v).any()) continue;
-        if (barycentric(x, X.row(v).transpose()).minCoeff() >= -1e-12) hangs[v] = 1;
+        if (barycentric(x, X.row(v).transpose()).minCoeff() < -1e-12) continue;
+        hangs[v] = 1;
+        if (host[v] == kNoNode || tree.level(node) < tree.level(host[v])) host[v] = node;
       }
     }
     Index expected = 0;
@@ -115,6 +120,7 @@ TEST(HangingConstraints, DetectionMatchesPointLocation) {
     EXPECT_EQ(c.constraints.num_free() + c.constraints.num_hanging(), X.rows());
     // Hosts are active tets coarser than the hanging vertex's level.
     for (const HangingVertex& h : c.constraints.hanging()) {
+      EXPECT_EQ(h.host, host[h.vertex]) << "vertex " << h.vertex;
       EXPECT_TRUE(cut.is_active(h.host));
       EXPECT_LT(h.host_level, tree.vertex_level(c.flat.tree_vertices[h.vertex]));
     }

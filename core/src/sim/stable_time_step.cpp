@@ -1,8 +1,13 @@
 #include "strata/core/sim/stable_time_step.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "strata/core/fem/deformation_gradient.hpp"
 
@@ -11,21 +16,27 @@ namespace strata {
 double max_angular_frequency_bound(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
                                    const Material& material) {
   const LameParameters lame = material.lame();
-  double max_gradient_eigenvalue = 0.0;
-  for (Index t = 0; t < tets.rows(); ++t) {
-    Matrix3x4d x;
-    for (int k = 0; k < 4; ++k)
-      x.col(k) = positions.row(tets(t, k)).transpose();
-    const Matrix3d Dm = edge_matrix(x);
-    if (!(std::abs(Dm.determinant()) > 0.0)) continue;  // degenerate tets are rejected earlier
-    const Eigen::Matrix<double, 4, 3> G = shape_function_gradients(Dm.inverse());
-    const Matrix3d GGt = G.transpose() * G;
-    max_gradient_eigenvalue =
-        std::max(max_gradient_eigenvalue,
-                 Eigen::SelfAdjointEigenSolver<Matrix3d>(GGt, Eigen::EigenvaluesOnly)
-                     .eigenvalues()
-                     .maxCoeff());
-  }
+  // The largest over all tets (exact in any order, so in parallel).
+  const double max_gradient_eigenvalue = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, tets.rows(), 1024), 0.0,
+      [&](const tbb::blocked_range<Index>& range, double largest) {
+        for (Index t = range.begin(); t != range.end(); ++t) {
+          Matrix3x4d x;
+          for (int k = 0; k < 4; ++k)
+            x.col(k) = positions.row(tets(t, k)).transpose();
+          const Matrix3d Dm = edge_matrix(x);
+          if (!(std::abs(Dm.determinant()) > 0.0))
+            continue;  // degenerate tets are rejected earlier
+          const Eigen::Matrix<double, 4, 3> G = shape_function_gradients(Dm.inverse());
+          const Matrix3d GGt = G.transpose() * G;
+          largest =
+              std::max(largest, Eigen::SelfAdjointEigenSolver<Matrix3d>(GGt, Eigen::EigenvaluesOnly)
+                                    .eigenvalues()
+                                    .maxCoeff());
+        }
+        return largest;
+      },
+      [](double a, double b) { return std::max(a, b); });
   return std::sqrt(4.0 * (3.0 * lame.lambda + 2.0 * lame.mu) * max_gradient_eigenvalue /
                    material.density);
 }
@@ -41,12 +52,25 @@ double stable_time_step_estimate(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
 }
 
 double mean_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets) {
+  // Partial sums over fixed blocks of tets, added in block order: the same value for every
+  // number of threads.
+  const Index num_tets = tets.rows();
+  if (num_tets == 0) return 0.0;
+  constexpr Index kBlock = 4096;
+  const Index num_blocks = (num_tets + kBlock - 1) / kBlock;
+  std::vector<double> partial(num_blocks, 0.0);
+  tbb::parallel_for(Index(0), num_blocks, [&](Index block) {
+    double sum = 0.0;
+    for (Index t = block * kBlock; t < std::min(num_tets, (block + 1) * kBlock); ++t)
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b)
+          sum += (positions.row(tets(t, a)) - positions.row(tets(t, b))).norm();
+    partial[block] = sum;
+  });
   double sum = 0.0;
-  for (Index t = 0; t < tets.rows(); ++t)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b)
-        sum += (positions.row(tets(t, a)) - positions.row(tets(t, b))).norm();
-  return tets.rows() > 0 ? sum / (6.0 * static_cast<double>(tets.rows())) : 0.0;
+  for (const double block_sum : partial)
+    sum += block_sum;
+  return sum / (6.0 * static_cast<double>(num_tets));
 }
 
 double mean_triangle_edge_length(ConstRef<MatrixX3d> positions, ConstRef<MatrixX3i> triangles) {
