@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "strata/app/huge_pages.hpp"
 #include "strata/app/mesh_command.hpp"
 #include "strata/app/precompute_command.hpp"
 #include "strata/app/progress_bar.hpp"
@@ -73,6 +74,9 @@ int run_info(const std::filesystem::path& path, const std::string& grid) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Runs build large matrices once: they start on a heap of huge pages (huge_pages.hpp).
+  if (argc > 1 && (std::string(argv[1]) == "run" || std::string(argv[1]) == "precompute"))
+    strata::app::use_huge_page_heap(argv);
   CLI::App app{"strata: tetrahedral FEM simulation of deformable solids", "strata"};
   app.set_version_flag("--version", STRATA_VERSION);
   app.require_subcommand(1);

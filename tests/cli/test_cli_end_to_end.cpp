@@ -3,7 +3,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <gnu/libc-version.h>
+
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <utility>
 
 #include "cli_test_utils.hpp"
 
@@ -49,6 +56,66 @@ TEST(CliEndToEnd, ProgressFileEndsAtTheWholeRun) {
   EXPECT_GE(elapsed, 0.0);
   const json stats = read_json(folder.path() / "out" / "scene" / "stats.json");
   EXPECT_LE(elapsed, stats["wall_seconds"].get<double>() + 1e-3);
+}
+
+/// The kernel's THP mode (the bracketed word of its sysfs file), "" without one.
+std::string thp_mode() {
+  std::ifstream file("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string line;
+  std::getline(file, line);
+  const auto open = line.find('[');
+  const auto close = line.find(']');
+  return open == std::string::npos || close == std::string::npos
+             ? ""
+             : line.substr(open + 1, close - open - 1);
+}
+
+/// Runs scene.json in `folder` with `name`=`value` set in the environment (unset when value is
+/// null) and returns stats.json's huge_pages and the probes.
+std::pair<std::string, std::string> run_with_environment(const TempFolder& folder, const char* name,
+                                                         const char* value) {
+  const char* before = std::getenv(name);
+  const std::string saved = before != nullptr ? before : "";
+  if (value != nullptr)
+    setenv(name, value, 1);
+  else
+    unsetenv(name);
+  const CliResult result = run_strata("run scene.json --quiet", folder.path());
+  if (before != nullptr)
+    setenv(name, saved.c_str(), 1);
+  else
+    unsetenv(name);
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.out, "");
+  EXPECT_EQ(result.err, "");
+  const std::filesystem::path out = folder.path() / "out" / "scene";
+  return {read_json(out / "stats.json")["huge_pages"].get<std::string>(),
+          read_text(out / "probes.csv")};
+}
+
+TEST(CliEndToEnd, HugePageHeapFollowsTheKernelAndTheOptOuts) {
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables != nullptr &&
+      std::string(tunables).find("glibc.malloc.hugetlb") != std::string::npos)
+    GTEST_SKIP() << "GLIBC_TUNABLES of the test names glibc.malloc.hugetlb";
+  TempFolder folder;
+  write_scene(folder, bar_scene());
+  const std::string mode = thp_mode();
+  int major = 0, minor = 0;
+  std::sscanf(gnu_get_libc_version(), "%d.%d", &major, &minor);
+  const bool tunable_known = major > 2 || (major == 2 && minor >= 35);
+  const std::string off = mode == "always" ? "always (kernel)" : "off";
+  const std::string expected = mode == "madvise" && tunable_known ? "on" : off;
+
+  const auto [state, probes] = run_with_environment(folder, "STRATA_HUGE_PAGES", nullptr);
+  EXPECT_EQ(state, expected) << "THP mode " << mode;
+  const auto [opted_out, opted_out_probes] = run_with_environment(folder, "STRATA_HUGE_PAGES", "0");
+  EXPECT_EQ(opted_out, off);
+  EXPECT_EQ(opted_out_probes, probes);  // the heap's pages do not change a result
+  const auto [tuned, tuned_probes] =
+      run_with_environment(folder, "GLIBC_TUNABLES", "glibc.malloc.hugetlb=0");
+  EXPECT_EQ(tuned, off);  // a tunable already set is the user's
+  EXPECT_EQ(tuned_probes, probes);
 }
 
 TEST(CliEndToEnd, StaticGravityReactionEqualsWeight) {

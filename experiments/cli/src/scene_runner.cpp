@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "strata/app/fine_surface.hpp"
+#include "strata/app/huge_pages.hpp"
 #include "strata/app/mesh_command.hpp"
 #include "strata/app/progress_bar.hpp"
 #include "strata/app/run_outputs.hpp"
@@ -270,6 +271,7 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                               std::to_string(counters.max_residual_ratio) +
                               " x the residual target) and were accepted as converged";
   stats["threads"] = max_threads();
+  stats["huge_pages"] = huge_page_heap_state();
   stats["vertices"] = simulation.mesh().vertices.rows();
   stats["tets"] = simulation.mesh().tets.rows();
   stats["dofs"] = simulation.embedded_model().num_dofs();

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "strata/app/huge_pages.hpp"
 #include "strata/app/progress_bar.hpp"
 #include "strata/app/run_outputs.hpp"
 #include "strata/core/common/error.hpp"
@@ -233,6 +234,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     stats["newton_iterations"] = run->newton_iterations();
     stats["substepped_steps"] = run->substepped_steps();
     stats["threads"] = max_threads();
+    stats["huge_pages"] = huge_page_heap_state();
     stats["mode"] = "dynamic";
     stats["integrator"] = to_string(scene.solver.integrator);
     stats["dt"] = scene.solver.dt;
