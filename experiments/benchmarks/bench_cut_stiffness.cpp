@@ -2,6 +2,8 @@
 // roots, 3 levels) refined to level 3 where a tet comes within 0.25 m of the top face's centre,
 // and graded outwards (level 2 within 0.5 m, level 1 within 0.75 m): levels 0–3 side by side, with
 // hanging vertices where they meet, as a local load leaves a cut. Neo-Hookean, E = 1 MPa, ν = 0.45.
+//   - cut_stiffness/flatten/threads:<n>: what a cut change spends on the flattened cut (mesh,
+//     hanging-vertex constraints) and its nested spaces for the multigrid;
 //   - cut_stiffness/build/threads:<n>: what a cut change spends on the elastic model, the mesh
 //     model (rest data, tet partition) and the reduced one (K_q's pattern and assembly plan) of
 //     the flattened cut;

@@ -421,13 +421,16 @@ SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   return options;
 }
 
-void AdaptiveSimulation::rebuild(long first_step) {
+double AdaptiveSimulation::rebuild(long first_step) {
+  const auto start = Clock::now();
   SimulationOptions options = flatten(first_step);
+  const double flatten_seconds = seconds_since(start);
   m_mesh_external = peak_loads(options);
   m_simulation = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
                                               std::vector<RegionLoad>{}, m_ground, m_gravity,
                                               m_solver, std::move(options));
   m_mesh_external += gravity_forces(m_simulation->vertex_mass(), m_gravity);
+  return flatten_seconds;
 }
 
 void AdaptiveSimulation::advance() {
@@ -576,6 +579,13 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
                                     VectorXd x_mesh, VectorXd v_mesh, double old_kinetic_energy,
                                     const Vector3d& old_momentum, PlasticState plastic) {
   const auto start = Clock::now();
+  auto phase = start;
+  const auto lap = [&phase] {
+    const auto now = Clock::now();
+    const double seconds = std::chrono::duration<double>(now - phase).count();
+    phase = now;
+    return seconds;
+  };
   const Simulation& sim = *m_simulation;
   CutChangeRecord record;
   record.step = sim.step_count();
@@ -588,6 +598,7 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     record.energy_before = old_kinetic_energy + sim.embedded_model().energy(x_q);
   }
   record.momentum_before = old_momentum;
+  record.phases.records = lap();
   // What the change needs of the current Simulation, taken before anything changes: that
   // Simulation is released before the next one is built, so that the new one is built in the
   // memory it frees (one Simulation at a time: a lower peak, and a first change as fast as the
@@ -607,7 +618,14 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   m_finished_counters = add(m_finished_counters, old_counters);
   m_simulation.reset();
   try {
-    rebuild(first_step);
+    record.phases.edit = lap();
+    record.phases.flatten = rebuild(first_step);
+    const SimulationBuildSeconds& built = m_simulation->build_seconds();
+    record.phases.elastic_model = built.elastic_model;
+    record.phases.reduced_model = built.reduced_model;
+    record.phases.stepper = built.stepper;
+    record.phases.problem =
+        lap() - record.phases.flatten - built.elastic_model - built.reduced_model - built.stepper;
     const FlatTreeMesh& new_flat = m_constrained->flat;
     const HangingConstraints& constraints = m_constrained->constraints;
     const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, x_mesh, new_flat);
@@ -619,6 +637,7 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_dof_vertex_mass,
                         old_kinetic_energy, old_momentum);
     if (!m_obstacles.empty()) record.contact_correction = m_simulation->push_out_of_obstacles();
+    record.phases.transfer = lap();
   } catch (...) {
     // The previous cut comes back with a Simulation rebuilt on it at the state that was being
     // moved (for the outputs of a failed run); the driver is marked failed and the change's
@@ -646,11 +665,13 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   for (NodeId parent : changes.coarsen)
     if (m_cut->is_active(parent)) m_tree->coarsen_subtree(parent);  // memory follows the cut
 
+  record.phases.edit += lap();
   record.tets_after = m_cut->size();
   record.dofs_after = m_simulation->embedded_model().num_dofs();
   record.energy_after = m_simulation->kinetic_energy() + m_simulation->elastic_energy();
   record.momentum_after = momentum(*m_simulation);
-  record.seconds = seconds_since(start);
+  record.phases.records += lap();
+  record.seconds = std::chrono::duration<double>(phase - start).count();
   m_bookkeeping_seconds += record.seconds;
   m_changes.push_back(record);
 }

@@ -108,10 +108,12 @@ std::vector<HangingVertex> find_hanging_vertices(const TetTree& tree, const Flat
   const auto num_vertices = static_cast<std::size_t>(flat.mesh.vertices.rows());
   STRATA_VERIFY(flat.tree_vertices.size() == num_vertices,
                 "find_hanging_vertices: flat mesh and its vertex map disagree");
-  // A mesh vertex on the boundary of a tet T (not a corner) lies on a refined edge of T; the
-  // active tets of the refined neighbour include, at each end of that edge, one finer than T with
-  // that end as a corner. So a tet none of whose corners belongs to a finer tet has no mesh vertex
-  // on its boundary, and only the others are walked.
+  // A mesh vertex on the boundary of a tet T of level l (not a corner) lies inside an edge or a
+  // face that T shares with a refined tet U of level l (the level-l tets are conforming). The
+  // corner children of U keep U's corners, so the active descendants of U include, at each corner
+  // of that edge or face, a tet finer than T with that corner. So a tet none of whose corners
+  // belongs to a finer active tet has no mesh vertex on its boundary, and only the others are
+  // walked.
   const auto num_tets = static_cast<Index>(flat.tet_nodes.size());
   std::vector<int> finest_level(num_vertices, 0);
   for (Index t = 0; t < num_tets; ++t) {

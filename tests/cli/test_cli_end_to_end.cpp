@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iostream>
 #include <string>
 #include <utility>
 
@@ -116,6 +117,14 @@ TEST(CliEndToEnd, HugePageHeapFollowsTheKernelAndTheOptOuts) {
       run_with_environment(folder, "GLIBC_TUNABLES", "glibc.malloc.hugetlb=0");
   EXPECT_EQ(tuned, off);  // a tunable already set is the user's
   EXPECT_EQ(tuned_probes, probes);
+  // Other tunables stay, and the huge-page one is added after them.
+  const auto [other, other_probes] =
+      run_with_environment(folder, "GLIBC_TUNABLES", "glibc.malloc.trim_threshold=4294967296");
+  EXPECT_EQ(other, expected);
+  EXPECT_EQ(other_probes, probes);
+  if (expected != "on")
+    std::cout << "[ NOTE     ] THP mode '" << mode << "', glibc " << gnu_get_libc_version()
+              << ": the re-execution is not exercised on this machine\n";
 }
 
 TEST(CliEndToEnd, StaticGravityReactionEqualsWeight) {

@@ -215,6 +215,21 @@ TEST(AdaptiveSimulation, RefinementKeepsTheEnergyAndTheCutFollowsTheLoad) {
   run(sim);
   ASSERT_FALSE(sim.changes().empty());
   for (const CutChangeRecord& change : sim.changes()) {
+    // The parts of a change's time are non-negative, add up to it, and the rebuild has them all.
+    const CutChangePhases& p = change.phases;
+    const std::array<double, 8> parts = {p.edit,    p.flatten, p.elastic_model, p.reduced_model,
+                                         p.problem, p.stepper, p.transfer,      p.records};
+    double sum = 0.0;
+    for (const double part : parts) {
+      EXPECT_GE(part, 0.0);
+      sum += part;
+    }
+    EXPECT_GT(change.seconds, 0.0);
+    EXPECT_NEAR(sum, change.seconds, 1e-9);
+    EXPECT_GT(p.flatten, 0.0);
+    EXPECT_GT(p.elastic_model, 0.0);
+    EXPECT_GT(p.reduced_model, 0.0);
+    EXPECT_GT(p.stepper, 0.0);
     // No prescribed vertex moves here (fixed bottom), so the transfer keeps the momentum of the
     // free vertices exactly (the fixed ones have zero velocity on every cut).
     EXPECT_LT((change.momentum_after - change.momentum_before).norm(),

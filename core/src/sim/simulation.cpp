@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -17,6 +18,16 @@ namespace strata {
 namespace {
 
 const MatrixX3i kNoFaces;  ///< the boundary of a scene without region loads: none needed
+
+using Clock = std::chrono::steady_clock;
+
+/// Seconds since `start`, and `start` moved to now.
+double lap(Clock::time_point& start) {
+  const Clock::time_point now = Clock::now();
+  const double seconds = std::chrono::duration<double>(now - start).count();
+  start = now;
+  return seconds;
+}
 
 std::string format_number(double value) {
   char buffer[32];
@@ -49,12 +60,15 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     throw InputError(
         "dirichlet: static mode needs at least one Dirichlet group against rigid motion");
 
+  Clock::time_point phase = Clock::now();
   m_model = std::make_unique<ElasticModel>(m_mesh.vertices, m_mesh.tets, m_material);
+  m_build_seconds.elastic_model = lap(phase);
   if (options.dof_vertices.empty())
     m_embedded = std::make_unique<EmbeddedElasticModel>(*m_model);
   else
     m_embedded = std::make_unique<EmbeddedElasticModel>(
         *m_model, std::move(options.vertex_embedding), std::move(options.dof_vertices));
+  m_build_seconds.reduced_model = lap(phase);
   const Index num_vertices = m_mesh.vertices.rows();
   const Index num_dof_vertices = m_embedded->num_dof_vertices();
   m_vertex_mass = lumped_vertex_mass(m_model->rest_data().rest_volume, m_mesh.tets, num_vertices,
@@ -173,7 +187,9 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .obstacles = &m_obstacles,
                              .contact_points = &m_contact_points,
                              .contact = contact});
+  m_build_seconds.problem = lap(phase);
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
+  m_build_seconds.stepper = lap(phase);
   if (is_static()) {
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), load_factor(), 0.0, m_x, m_v);
     m_v.setZero();

@@ -201,6 +201,15 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
                        {"energy_before", change.energy_before},
                        {"energy_after", change.energy_after},
                        {"seconds", change.seconds},
+                       {"phase_seconds",
+                        {{"edit", change.phases.edit},
+                         {"flatten", change.phases.flatten},
+                         {"elastic_model", change.phases.elastic_model},
+                         {"reduced_model", change.phases.reduced_model},
+                         {"problem", change.phases.problem},
+                         {"stepper", change.phases.stepper},
+                         {"transfer", change.phases.transfer},
+                         {"records", change.phases.records}}},
                        {"plastic_merge_change", change.plastic_merge_change},
                        {"contact_correction", change.contact_correction}});
   }

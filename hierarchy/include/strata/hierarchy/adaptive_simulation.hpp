@@ -115,6 +115,18 @@ struct HierarchySettings {
 void validate_hierarchy_settings(const HierarchySettings& settings, const std::string& where);
 
 /// One change of the active cut.
+/// Wall time of the parts of one cut change [s]; they add up to its `seconds`.
+struct CutChangePhases {
+  double edit = 0.0;     ///< the controller's edit of the cut (and the cut kept in case it fails)
+  double flatten = 0.0;  ///< flattened cut, hanging-vertex constraints, nested spaces, mapped loads
+  double elastic_model = 0.0;  ///< the new Simulation's parts (SimulationBuildSeconds) …
+  double reduced_model = 0.0;
+  double problem = 0.0;  ///< … with the driver's load and gravity vectors
+  double stepper = 0.0;
+  double transfer = 0.0;  ///< positions, velocities, plastic state, kinetic energy, contact
+  double records = 0.0;   ///< energies before and after
+};
+
 struct CutChangeRecord {
   long step = 0;                          ///< after this step (static: load step) …
   int pass = 0;                           ///< … and this pass (static; 0 in dynamic runs)
@@ -127,7 +139,8 @@ struct CutChangeRecord {
   double energy_after = 0.0;              ///< … just after (state transferred) [J]
   Vector3d momentum_before = Vector3d::Zero();  ///< Σ m_q v_q just before the change [kg·m/s]
   Vector3d momentum_after = Vector3d::Zero();   ///< … just after
-  double seconds = 0.0;  ///< wall time of the change (decide, edit, flatten, rebuild)
+  double seconds = 0.0;    ///< wall time of the change (edit, flatten, rebuild, transfer, records)
+  CutChangePhases phases;  ///< … by part
   /// Plastic materials: largest |ε̄ₚ(child) − ε̄ₚ(parent)| over the merges of this change (the
   /// detail a merge averages away; 0 without merges or plasticity).
   double plastic_merge_change = 0.0;
@@ -251,7 +264,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// returns the options of a Simulation on it that starts at `first_step`.
   SimulationOptions flatten(long first_step);
   /// flatten() and a new Simulation on the cut; m_mesh_external follows.
-  void rebuild(long first_step);
+  /// Flattens the cut and builds its Simulation; returns the flattening's seconds.
+  double rebuild(long first_step);
   /// *m_simulation; throws std::logic_error when a failed cut change left none.
   const Simulation& live() const;
   bool adapt(int pass, bool refine, bool coarsen);

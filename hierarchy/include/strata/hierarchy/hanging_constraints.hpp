@@ -22,7 +22,9 @@
 /// lumped masses m_q = Cᵀ m (= row sums of Cᵀ diag(m) C since C·1 = 1: total mass is kept, no entry
 /// negative).
 ///
-/// Detection (`find_hanging_vertices`): for each active tet, walk the tree vertices on its edges
+/// Detection (`find_hanging_vertices`): for each active tet with a corner that is also a corner of
+/// a finer active tet (no other tet can have a mesh vertex on its boundary), walk the tree
+/// vertices on its edges
 /// (edge midpoints, recursively along the halves) and inside its faces (midpoints of the face's
 /// mid-segments, recursively in the four sub-triangles) through TetTree::midpoint; every one that
 /// is a vertex of the flattened mesh hangs on that tet. Since the parents of a mesh vertex are mesh

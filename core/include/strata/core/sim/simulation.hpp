@@ -57,6 +57,14 @@ struct GroupReaction {
   Vector3d moment_center = Vector3d::Zero();  ///< [m]
 };
 
+/// Wall time of the parts of a Simulation's construction [s].
+struct SimulationBuildSeconds {
+  double elastic_model = 0.0;  ///< rest data and element schedule of the mesh (ElasticModel)
+  double reduced_model = 0.0;  ///< the model on the DOF vertices: patterns, assembly plan
+  double problem = 0.0;        ///< masses, Dirichlet groups, loads, contact points
+  double stepper = 0.0;        ///< the time stepper: DOF reduction, energy terms, solver transfers
+};
+
 /// Optional construction parameters, for drivers that rebuild the simulation on a new mesh
 /// mid-run (the adaptive hierarchy).
 struct SimulationOptions {
@@ -192,6 +200,8 @@ class Simulation final : public SimulationRun {
 
   const TetMesh& mesh() const { return m_mesh; }
   const ElasticModel& model() const { return *m_model; }  ///< on the mesh (3·#V)
+  /// Where the construction's time went.
+  const SimulationBuildSeconds& build_seconds() const { return m_build_seconds; }
   /// The model on the DOFs (x = P q).
   const EmbeddedElasticModel& embedded_model() const { return *m_embedded; }
   const SolverSettings& settings() const { return m_settings; }
@@ -261,6 +271,7 @@ class Simulation final : public SimulationRun {
   TetMesh m_mesh;
   Material m_material;
   SolverSettings m_settings;
+  SimulationBuildSeconds m_build_seconds;
   std::unique_ptr<ElasticModel> m_model;
   std::unique_ptr<EmbeddedElasticModel> m_embedded;
   mutable std::once_flag m_boundary_once;  ///< boundary() may be first called from any thread

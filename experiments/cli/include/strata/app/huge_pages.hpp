@@ -11,14 +11,17 @@
 
 namespace strata::app {
 
-/// Why a process does or does not run with the huge-page heap, for stats.json.
+/// The heap this process runs on, for stats.json: "on" (glibc.malloc.hugetlb=1 on a kernel in
+/// `madvise` mode), "always (kernel)" (the kernel gives huge pages to all memory), "off", or the
+/// tunable as the user set it to another value (e.g. "glibc.malloc.hugetlb=2": hugetlbfs pages).
 std::string huge_page_heap_state();
 
-/// Re-executes this program (/proc/self/exe, the same arguments and environment) with
-/// `glibc.malloc.hugetlb=1` added to GLIBC_TUNABLES. It does not (and returns) when
+/// Re-executes this program (its path from /proc/self/exe, the same arguments and environment)
+/// with `glibc.malloc.hugetlb=1` added to GLIBC_TUNABLES. It does not (and returns) when
 /// GLIBC_TUNABLES already names that tunable (whatever its value), STRATA_HUGE_PAGES is `0`,
 /// glibc is older than 2.35, the kernel's THP mode is not `madvise` (`always` needs nothing,
-/// `never` allows nothing), or the exec fails.
+/// `never` allows nothing, no sysfs file: no THP), the process runs in secure-execution mode or
+/// was started by invoking the dynamic loader, or the exec fails.
 void use_huge_page_heap(char** argv);
 
 }  // namespace strata::app
