@@ -1,9 +1,10 @@
 #include "strata/core/fem/tet_partition.hpp"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <numeric>
 
@@ -22,6 +23,28 @@ std::uint64_t spread_bits(std::uint64_t v) {
   return v;
 }
 
+/// Sorts (key, value) pairs by key, stably: least significant byte first, eight counting passes,
+/// skipping the bytes in which all keys agree.
+void stable_radix_sort(std::vector<std::pair<std::uint64_t, int>>& items) {
+  std::vector<std::pair<std::uint64_t, int>> buffer(items.size());
+  std::uint64_t all_or = 0, all_and = ~std::uint64_t{0};
+  for (const auto& item : items) {
+    all_or |= item.first;
+    all_and &= item.first;
+  }
+  for (int shift = 0; shift < 64; shift += 8) {
+    if ((((all_or ^ all_and) >> shift) & 0xff) == 0) continue;  // one value of this byte
+    std::array<std::size_t, 257> start{};
+    for (const auto& item : items)
+      ++start[((item.first >> shift) & 0xff) + 1];
+    for (int b = 0; b < 256; ++b)
+      start[b + 1] += start[b];
+    for (const auto& item : items)
+      buffer[start[(item.first >> shift) & 0xff]++] = item;
+    items.swap(buffer);
+  }
+}
+
 }  // namespace
 
 TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
@@ -38,7 +61,7 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
   // Morton order of the tet centroids.
   const Vector3d lower = positions.colwise().minCoeff().transpose();
   const Vector3d extent = (positions.colwise().maxCoeff().transpose() - lower).cwiseMax(1e-300);
-  // (code, tet) pairs: sorting them orders ties by tet index, as a stable sort by code would.
+  // (code, tet) pairs, sorted by code; ties keep the tets' order (a stable sort from tet order).
   std::vector<std::pair<std::uint64_t, int>> keyed(num_tets);
   tbb::parallel_for(Index(0), num_tets, [&](Index t) {
     Vector3d centroid = Vector3d::Zero();
@@ -52,7 +75,7 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
     }
     keyed[t] = {key, static_cast<int>(t)};
   });
-  tbb::parallel_sort(keyed.begin(), keyed.end());
+  stable_radix_sort(keyed);
   for (Index i = 0; i < num_tets; ++i)
     partition.order[i] = keyed[i].second;
 
@@ -66,44 +89,46 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
   partition.chunk_begin.push_back(static_cast<int>(num_tets));
   const Index num_chunks = partition.num_chunks();
 
-  // Chunks touching each vertex (compressed lists, ascending), then greedy colouring in chunk
-  // order. `seen[v] == c` marks vertex v as visited for chunk c.
+  // The vertices of each chunk (in parallel), then greedy colouring in chunk order: a chunk takes
+  // the smallest colour that no earlier chunk sharing one of its vertices has. `taken[v]` holds
+  // the colours of the chunks coloured so far that contain v, as bits (colours 64 and up in
+  // further words).
   const Index num_vertices = positions.rows();
-  std::vector<int> seen(num_vertices, -1);
-  std::vector<int> start(num_vertices + 1, 0);
-  const auto for_each_chunk_vertex = [&](Index c, auto&& body) {
+  std::vector<std::vector<int>> chunk_vertices(num_chunks);
+  tbb::enumerable_thread_specific<std::vector<int>> stamps(
+      [&] { return std::vector<int>(num_vertices, -1); });
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    std::vector<int>& stamp = stamps.local();
+    std::vector<int>& vertices = chunk_vertices[c];
     for (int i = partition.chunk_begin[c]; i < partition.chunk_begin[c + 1]; ++i)
       for (int k = 0; k < 4; ++k) {
         const int v = tets(partition.order[i], k);
-        if (seen[v] == c) continue;
-        seen[v] = static_cast<int>(c);
-        body(v);
+        if (stamp[v] == c) continue;
+        stamp[v] = static_cast<int>(c);
+        vertices.push_back(v);
       }
-  };
-  for (Index c = 0; c < num_chunks; ++c)
-    for_each_chunk_vertex(c, [&](int v) { ++start[v + 1]; });
-  for (Index v = 0; v < num_vertices; ++v)
-    start[v + 1] += start[v];
-  std::vector<int> vertex_chunks(start[num_vertices]);
-  std::vector<int> next(start.begin(), start.end() - 1);
-  seen.assign(num_vertices, -1);
-  for (Index c = 0; c < num_chunks; ++c)
-    for_each_chunk_vertex(c, [&](int v) { vertex_chunks[next[v]++] = static_cast<int>(c); });
-
-  std::vector<int> chunk_color(num_chunks, -1);
-  std::vector<char> used;
-  seen.assign(num_vertices, -1);
+  });
+  Index words = 1;
+  std::vector<std::uint64_t> taken(num_vertices, 0);
+  std::vector<std::uint64_t> used;
   for (Index c = 0; c < num_chunks; ++c) {
-    used.assign(num_chunks + 1, 0);
-    for_each_chunk_vertex(c, [&](int v) {
-      for (int j = start[v]; j < start[v + 1]; ++j)
-        if (chunk_color[vertex_chunks[j]] >= 0) used[chunk_color[vertex_chunks[j]]] = 1;
-    });
-    int color = 0;
-    while (used[color])
+    used.assign(words, 0);
+    for (const int v : chunk_vertices[c])
+      for (Index w = 0; w < words; ++w)
+        used[w] |= taken[words * v + w];
+    Index color = 0;
+    while (color < 64 * words && (used[color / 64] >> (color % 64) & 1u) != 0)
       ++color;
-    chunk_color[c] = color;
-    if (color >= static_cast<int>(partition.colors.size())) partition.colors.resize(color + 1);
+    if (color == 64 * words) {  // every colour so far is taken: one more word per vertex
+      std::vector<std::uint64_t> wider(num_vertices * (words + 1), 0);
+      for (Index v = 0; v < num_vertices; ++v)
+        std::copy_n(&taken[words * v], words, &wider[(words + 1) * v]);
+      taken.swap(wider);
+      ++words;
+    }
+    for (const int v : chunk_vertices[c])
+      taken[words * v + color / 64] |= std::uint64_t{1} << (color % 64);
+    if (color >= static_cast<Index>(partition.colors.size())) partition.colors.resize(color + 1);
     partition.colors[color].push_back(static_cast<int>(c));
   }
   return partition;
