@@ -70,24 +70,10 @@ std::size_t TetTree::memory_bytes() const {
          m_free_vertices.capacity() * sizeof(int) + m_midpoints.memory_bytes();
 }
 
-const TetNode& TetTree::node(NodeId n) const {
-  STRATA_VERIFY(n >= 0 && static_cast<std::size_t>(n) < m_nodes.size(), "node id out of range");
-  return m_nodes[n];
-}
-
-bool TetTree::is_alive(NodeId n) const {
-  return n >= 0 && static_cast<std::size_t>(n) < m_nodes.size() && m_nodes[n].alive != 0;
-}
-
 NodeId TetTree::child(NodeId n, int k) const {
   STRATA_VERIFY(k >= 0 && k < 8, "child slot must be in 0..7");
   const NodeId first = node(n).first_child;
   return first == kNoNode ? kNoNode : first + k;
-}
-
-std::array<int, 4> TetTree::tet_vertices(NodeId n) const {
-  const TetNode& record = node(n);
-  return oriented_tet(record.vertices, record.orientation);
 }
 
 Matrix3x4d TetTree::tet_positions(NodeId n) const {
@@ -132,12 +118,6 @@ std::vector<NodeId> TetTree::leaves() const {
     result.insert(result.end(), subtree.begin(), subtree.end());
   }
   return result;
-}
-
-std::size_t TetTree::checked_vertex(int v) const {
-  STRATA_VERIFY(v >= 0 && static_cast<std::size_t>(v) < m_positions.size(),
-                "vertex id out of range");
-  return static_cast<std::size_t>(v);
 }
 
 bool TetTree::is_vertex_alive(int v) const {

@@ -27,7 +27,8 @@ ConstrainedCut graded_box(TetTree& tree) {
   for (const NodeId n : cut.sorted_nodes())
     if (tree.tet_positions(n).row(0).minCoeff() < 0.6) cut.refine(n);
   for (const NodeId n : cut.sorted_nodes()) {
-    const auto x = tree.tet_positions(n).row(0);
+    const Eigen::RowVector4d x =
+        tree.tet_positions(n).row(0);  // a copy: the positions are a temporary
     if (tree.level(n) == 1 && (x.minCoeff() < 0.2 || x.maxCoeff() > 0.99)) cut.refine(n);
   }
   return flatten_cut(cut);

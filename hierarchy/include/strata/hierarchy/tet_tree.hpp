@@ -37,9 +37,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "strata/core/common/error.hpp"
 #include "strata/core/common/types.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/hierarchy/edge_midpoint_map.hpp"
+#include "strata/hierarchy/red_refinement.hpp"
 
 namespace strata {
 
@@ -95,8 +97,13 @@ class TetTree {
 
   // --- nodes -----------------------------------------------------------------------------------
   /// The record of node `n` (checked: 0 ≤ n < pool_size()).
-  const TetNode& node(NodeId n) const;
-  bool is_alive(NodeId n) const;
+  const TetNode& node(NodeId n) const {
+    STRATA_VERIFY(n >= 0 && static_cast<std::size_t>(n) < m_nodes.size(), "node id out of range");
+    return m_nodes[n];
+  }
+  bool is_alive(NodeId n) const {
+    return n >= 0 && static_cast<std::size_t>(n) < m_nodes.size() && m_nodes[n].alive != 0;
+  }
   bool is_leaf(NodeId n) const { return node(n).first_child == kNoNode; }
   int level(NodeId n) const { return node(n).level; }
   NodeId parent(NodeId n) const { return node(n).parent; }
@@ -106,7 +113,10 @@ class TetTree {
   const std::array<int, 4>& bey_vertices(NodeId n) const { return node(n).vertices; }
   /// Vertices in a positively oriented order (Bey order, last two swapped when needed): the order
   /// of the tet in a flattened mesh.
-  std::array<int, 4> tet_vertices(NodeId n) const;
+  std::array<int, 4> tet_vertices(NodeId n) const {
+    const TetNode& record = node(n);
+    return oriented_tet(record.vertices, record.orientation);
+  }
   /// Rest positions of `tet_vertices(n)` as columns (3 × 4).
   Matrix3x4d tet_positions(NodeId n) const;
   /// Rest positions of `bey_vertices(n)` as columns (3 × 4).
@@ -147,7 +157,11 @@ class TetTree {
   Index coarsen_subtree(NodeId n);
 
  private:
-  std::size_t checked_vertex(int v) const;
+  std::size_t checked_vertex(int v) const {
+    STRATA_VERIFY(v >= 0 && static_cast<std::size_t>(v) < m_positions.size(),
+                  "vertex id out of range");
+    return static_cast<std::size_t>(v);
+  }
   NodeId allocate_block();
   int midpoint_or_create(int a, int b);
   void release_vertex(int v);
