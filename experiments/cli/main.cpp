@@ -82,6 +82,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   CLI::App* run = app.add_subcommand("run", "Run a scene file and write its outputs");
+  run->footer(
+      "Environment: STRATA_HUGE_PAGES=0 keeps the heap on small pages (by default run restarts "
+      "itself once with GLIBC_TUNABLES=glibc.malloc.hugetlb=1; README, Huge pages).");
   std::string scene_file;
   std::string out_dir;
   std::vector<std::string> overrides;

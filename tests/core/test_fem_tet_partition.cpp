@@ -15,32 +15,33 @@
 namespace strata {
 namespace {
 
-/// Morton code of a tet's centroid in the mesh's bounding box, 21 bits per axis, x lowest.
-std::uint64_t morton_code(const MatrixX3d& vertices, const MatrixX4i& tets, Index t) {
+/// Morton codes of the tets' centroids in the mesh's bounding box, 21 bits per axis, x lowest.
+std::vector<std::uint64_t> morton_codes(const MatrixX3d& vertices, const MatrixX4i& tets) {
   const Vector3d lower = vertices.colwise().minCoeff().transpose();
   const Vector3d extent = vertices.colwise().maxCoeff().transpose() - lower;
-  Vector3d centroid = Vector3d::Zero();
-  for (int k = 0; k < 4; ++k)
-    centroid += vertices.row(tets(t, k)).transpose();
-  const Vector3d unit = ((0.25 * centroid - lower).array() / extent.array()).matrix();
-  std::uint64_t code = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto cell = static_cast<std::uint64_t>(std::clamp(unit[axis], 0.0, 1.0) * 2097151.0);
-    for (int bit = 0; bit < 21; ++bit)
-      code |= ((cell >> bit) & 1u) << (3 * bit + axis);
+  std::vector<std::uint64_t> codes(static_cast<std::size_t>(tets.rows()), 0);
+  for (Index t = 0; t < tets.rows(); ++t) {
+    Vector3d centroid = Vector3d::Zero();
+    for (int k = 0; k < 4; ++k)
+      centroid += vertices.row(tets(t, k)).transpose();
+    const Vector3d unit = ((0.25 * centroid - lower).array() / extent.array()).matrix();
+    for (int axis = 0; axis < 3; ++axis) {
+      const auto cell = static_cast<std::uint64_t>(std::clamp(unit[axis], 0.0, 1.0) * 2097151.0);
+      for (int bit = 0; bit < 21; ++bit)
+        codes[t] |= ((cell >> bit) & 1u) << (3 * bit + axis);
+    }
   }
-  return code;
+  return codes;
 }
 
 void expect_valid_schedule(const MatrixX3d& vertices, const MatrixX4i& tets, int target_chunks) {
   const TetPartition partition = build_tet_partition(vertices, tets, target_chunks);
   const Index num_tets = tets.rows();
   // Morton order of the centroids, ties in tet order.
+  const std::vector<std::uint64_t> codes = morton_codes(vertices, tets);
   for (Index i = 1; i < num_tets; ++i) {
     const int a = partition.order[i - 1], b = partition.order[i];
-    const std::uint64_t code_a = morton_code(vertices, tets, a);
-    const std::uint64_t code_b = morton_code(vertices, tets, b);
-    ASSERT_TRUE(code_a < code_b || (code_a == code_b && a < b)) << "position " << i;
+    ASSERT_TRUE(codes[a] < codes[b] || (codes[a] == codes[b] && a < b)) << "position " << i;
   }
   // A permutation of the tets.
   std::vector<int> sorted = partition.order;
@@ -113,6 +114,25 @@ TEST(TetPartition, ShuffledTetsOfAThinMeshAreScheduledAsDefined) {
   for (Index t = 0; t < tets.rows(); ++t)
     tets.row(t) = plate.tets.row(order[t]);
   expect_valid_schedule(plate.vertices, tets, 256);
+}
+
+TEST(TetPartition, MoreThan64ColoursAreScheduledAsDefined) {
+  // A fan of 20,480 tets around one shared vertex: 80 chunks that all meet there need 80 colours,
+  // more than one 64-bit word per vertex holds.
+  const Index num_tets = 80 * 256;
+  MatrixX3d vertices(1 + 3 * num_tets, 3);
+  vertices.row(0).setZero();
+  std::mt19937 random(11u);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (Index v = 1; v < vertices.rows(); ++v)
+    for (int k = 0; k < 3; ++k)
+      vertices(v, k) = uniform(random);
+  MatrixX4i tets(num_tets, 4);
+  for (Index t = 0; t < num_tets; ++t)
+    tets.row(t) << 0, static_cast<int>(1 + 3 * t), static_cast<int>(2 + 3 * t),
+        static_cast<int>(3 + 3 * t);
+  EXPECT_EQ(build_tet_partition(vertices, tets, 256).colors.size(), 80u);
+  expect_valid_schedule(vertices, tets, 256);
 }
 
 TEST(TetPartition, FewTetsMakeOneChunk) {

@@ -56,10 +56,11 @@ std::string tunable_value(const std::string& tunables) {
 }  // namespace
 
 std::string huge_page_heap_state() {
-  if (thp_mode() == "always") return "always (kernel)";
+  const std::string mode = thp_mode();
+  if (mode == "always") return "always (kernel)";
   const std::string value = tunable_value(environment("GLIBC_TUNABLES"));
   if (value.empty() || value == "0") return "off";
-  if (value == "1" && thp_mode() == "madvise" && glibc_has_hugetlb_tunable()) return "on";
+  if (value == "1" && mode == "madvise" && glibc_has_hugetlb_tunable()) return "on";
   return std::string(kTunable) + "=" + value;
 }
 
