@@ -1,5 +1,6 @@
 #include "strata/core/sim/dof_reduction.hpp"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -12,10 +13,10 @@ DofReduction::DofReduction(const SparseMatrixd& pattern, const std::vector<char>
   STRATA_VERIFY(pattern.isCompressed() && pattern.rows() == pattern.cols() &&
                     static_cast<size_t>(pattern.rows()) == constrained.size(),
                 "DofReduction: pattern must be compressed, square and match the DOF mask");
-  std::vector<Index> reduced_index(constrained.size(), -1);
+  std::vector<int> reduced_index(constrained.size(), -1);
   for (size_t i = 0; i < constrained.size(); ++i) {
     if (constrained[i]) continue;
-    reduced_index[i] = static_cast<Index>(m_free.size());
+    reduced_index[i] = static_cast<int>(m_free.size());
     m_free.push_back(static_cast<Index>(i));
   }
   // Removing rows and columns keeps each column's rows ascending: the reduced pattern is the
@@ -40,10 +41,10 @@ DofReduction::DofReduction(const SparseMatrixd& pattern, const std::vector<char>
   double* values = m_reduced_pattern.valuePtr();
   tbb::parallel_for(Index(0), num_free(), [&](Index c) {
     Index k = outer[c];
-    for (Index p = full_outer[m_free[c]]; p < full_outer[m_free[c] + 1]; ++p) {
-      const Index row = reduced_index[full_inner[p]];
+    for (int p = full_outer[m_free[c]]; p < full_outer[m_free[c] + 1]; ++p) {
+      const int row = reduced_index[full_inner[p]];
       if (row < 0) continue;
-      inner[k] = static_cast<int>(row);
+      inner[k] = row;
       values[k] = 0.0;
       m_source[k++] = p;
     }
@@ -70,8 +71,12 @@ void DofReduction::restrict_matrix(const SparseMatrixd& full, SparseMatrixd& red
     reduced = m_reduced_pattern;
   double* values = reduced.valuePtr();
   const double* source = full.valuePtr();
-  for (size_t k = 0; k < m_source.size(); ++k)
-    values[k] = source[m_source[k]];
+  const int* from = m_source.data();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_source.size(), 16384),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k)
+                        values[k] = source[from[k]];
+                    });
 }
 
 }  // namespace strata

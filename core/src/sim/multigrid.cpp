@@ -63,23 +63,44 @@ std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
       for (int c = 0; c < 3; ++c)
         if (free_index[k + 1][3 * injection[j] + c] >= 0) index[3 * j + c] = next++;
   }
+  // Column 3j + c of P_k ⊗ I₃ holds the rows 3i + c of column j of P_k; restricted to the free
+  // DOFs, both index maps are ascending, so each column is written in place in P_k's row order.
   for (int k = 0; k + 1 < levels; ++k) {
     const SparseMatrixd& P = spaces.prolongations[k];
     const std::vector<Index>& rows = free_index[k + 1];
     const std::vector<Index>& cols = free_index[k];
     const Index num_rows = std::count_if(rows.begin(), rows.end(), [](Index i) { return i >= 0; });
     const Index num_cols = std::count_if(cols.begin(), cols.end(), [](Index i) { return i >= 0; });
-    std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(3 * P.nonZeros());
-    for (Index j = 0; j < P.outerSize(); ++j)
-      for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
-        for (int c = 0; c < 3; ++c) {
-          const Index row = rows[3 * it.row() + c];
-          const Index col = cols[3 * j + c];
-          if (row >= 0 && col >= 0) triplets.emplace_back(row, col, it.value());
-        }
     SparseMatrixd D(num_rows, num_cols);
-    D.setFromTriplets(triplets.begin(), triplets.end());
+    int* outer = D.outerIndexPtr();
+    outer[0] = 0;
+    for (Index j = 0; j < P.outerSize(); ++j)
+      for (int c = 0; c < 3; ++c) {
+        const Index col = cols[3 * j + c];
+        if (col < 0) continue;
+        int count = 0;
+        for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
+          count += rows[3 * it.row() + c] >= 0;
+        outer[col + 1] = count;
+      }
+    for (Index col = 0; col < num_cols; ++col)
+      outer[col + 1] += outer[col];
+    D.resizeNonZeros(outer[num_cols]);
+    int* inner = D.innerIndexPtr();
+    double* values = D.valuePtr();
+    tbb::parallel_for(Index(0), P.outerSize(), [&](Index j) {
+      for (int c = 0; c < 3; ++c) {
+        const Index col = cols[3 * j + c];
+        if (col < 0) continue;
+        Index position = outer[col];
+        for (SparseMatrixd::InnerIterator it(P, j); it; ++it) {
+          const Index row = rows[3 * it.row() + c];
+          if (row < 0) continue;
+          inner[position] = static_cast<int>(row);
+          values[position++] = it.value();
+        }
+      }
+    });
     result.push_back(std::move(D));
   }
   return result;

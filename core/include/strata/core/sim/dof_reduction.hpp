@@ -30,7 +30,7 @@ class DofReduction {
  private:
   std::vector<Index> m_free;
   SparseMatrixd m_reduced_pattern;
-  std::vector<Index> m_source;  ///< for each reduced value, its index in the full value array
+  std::vector<int> m_source;  ///< for each reduced value, its index in the full value array
   Index m_full_nonzeros = 0;
 };
 
