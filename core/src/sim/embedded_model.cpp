@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <string>
+#include <utility>
 
 #include "strata/core/common/compressed_lists.hpp"
 #include "strata/core/common/error.hpp"
@@ -19,6 +21,69 @@ namespace {
 
 double rest_edge_length_mean(const ElasticModel& model) {
   return mean_edge_length(unflatten(model.rest_positions()), model.tets());
+}
+
+/// The neighbours of each mesh vertex (the corners of its tets, itself included) and, of those,
+/// the corners of its tets with `in_layer` set: two sorted lists per vertex, from one gather.
+std::pair<CompressedLists, CompressedLists> neighbour_lists(
+    const CompressedLists& incident, const std::vector<int>& sorted_tets,
+    const std::vector<std::uint8_t>& in_layer, Index num_vertices) {
+  std::pair<CompressedLists, CompressedLists> result;
+  CompressedLists& all = result.first;
+  CompressedLists& layer = result.second;
+  all.offsets.assign(num_vertices + 1, 0);
+  layer.offsets.assign(num_vertices + 1, 0);
+  if (num_vertices == 0) return result;
+  // Fixed chunks, each collecting its lists in buffers of its own; then one copy into place.
+  const Index num_chunks = std::min<Index>(num_vertices, 256);
+  std::vector<std::vector<int>> chunk_all(num_chunks), chunk_layer(num_chunks);
+  struct Seen {
+    std::vector<int> by;              // the vertex whose list last took each entry
+    std::vector<std::uint8_t> layer;  // whether that list reached it through a layer tet
+  };
+  tbb::enumerable_thread_specific<Seen> seen_lists([&] {
+    return Seen{std::vector<int>(num_vertices, -1), std::vector<std::uint8_t>(num_vertices)};
+  });
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    const Index begin = num_vertices * c / num_chunks, end = num_vertices * (c + 1) / num_chunks;
+    Seen& seen = seen_lists.local();
+    std::vector<int>& out = chunk_all[c];
+    std::vector<int>& out_layer = chunk_layer[c];
+    for (Index w = begin; w < end; ++w) {
+      const auto first = out.size();
+      for (const int t : incident[w]) {
+        const std::uint8_t layer_tet = in_layer[t];
+        for (const int v : std::span<const int>(&sorted_tets[4 * t], 4)) {
+          if (seen.by[v] == static_cast<int>(w)) {
+            seen.layer[v] |= layer_tet;
+            continue;
+          }
+          seen.by[v] = static_cast<int>(w);
+          seen.layer[v] = layer_tet;
+          out.push_back(v);
+        }
+      }
+      std::sort(out.begin() + first, out.end());
+      const auto first_layer = out_layer.size();
+      for (auto k = first; k < out.size(); ++k)
+        if (seen.layer[out[k]]) out_layer.push_back(out[k]);
+      all.offsets[w + 1] = static_cast<Index>(out.size() - first);
+      layer.offsets[w + 1] = static_cast<Index>(out_layer.size() - first_layer);
+    }
+  });
+  for (Index w = 0; w < num_vertices; ++w) {
+    all.offsets[w + 1] += all.offsets[w];
+    layer.offsets[w + 1] += layer.offsets[w];
+  }
+  all.indices.resize(all.offsets[num_vertices]);
+  layer.indices.resize(layer.offsets[num_vertices]);
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    const Index begin = num_vertices * c / num_chunks;
+    std::copy(chunk_all[c].begin(), chunk_all[c].end(), all.indices.begin() + all.offsets[begin]);
+    std::copy(chunk_layer[c].begin(), chunk_layer[c].end(),
+              layer.indices.begin() + layer.offsets[begin]);
+  });
+  return result;
 }
 
 }  // namespace
@@ -183,27 +248,6 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     incident = transpose_lists(tet_lists, num_mesh_vertices);
   }
 
-  // Block pattern: the reduced neighbours a of DOF vertex b.
-  CompressedLists block_lists;
-  {
-    const CompressedLists neighbours = sorted_unique_lists(
-        num_mesh_vertices, num_mesh_vertices, [&](Index w, std::vector<int>& out) {
-          for (const int t : incident[w])
-            out.insert(out.end(), &sorted_tets[4 * t], &sorted_tets[4 * t] + 4);
-        });
-    block_lists = sorted_unique_lists(
-        m_num_dof_vertices, m_num_dof_vertices, [&](Index b, std::vector<int>& out) {
-          for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
-            for (const int v : neighbours[w.row()])
-              out.insert(out.end(), row_inner + row_outer[v], row_inner + row_outer[v + 1]);
-        });
-  }
-  const CompressedLists& blocks = block_lists;
-  {
-    SparseMatrixd pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
-    m_pattern.swap(pattern);  // Eigen's assignment from a named matrix would copy it
-  }
-
   // A mesh vertex whose C row is e_q for its own DOF vertex q is direct. Distinct direct vertices
   // have distinct DOF vertices, so tets of direct vertices that share no vertex share no target.
   std::vector<int> direct_dof(num_mesh_vertices, -1);
@@ -221,11 +265,22 @@ void EmbeddedElasticModel::build_reduced_pattern() {
                     direct_dof[tet[3]] < 0;
   });
   m_num_layer_tets = std::count(m_in_layer.begin(), m_in_layer.end(), std::uint8_t(1));
-  const CompressedLists layer = sorted_unique_lists(
-      num_mesh_vertices, num_mesh_vertices, [&](Index w, std::vector<int>& out) {
-        for (const int t : incident[w])
-          if (m_in_layer[t]) out.insert(out.end(), &sorted_tets[4 * t], &sorted_tets[4 * t] + 4);
+  const std::pair<CompressedLists, CompressedLists> lists =
+      neighbour_lists(incident, sorted_tets, m_in_layer, num_mesh_vertices);
+  const CompressedLists& neighbours = lists.first;
+  const CompressedLists& layer = lists.second;
+
+  // Block pattern: the reduced neighbours a of DOF vertex b.
+  const CompressedLists blocks = sorted_unique_lists(
+      m_num_dof_vertices, m_num_dof_vertices, [&](Index b, std::vector<int>& out) {
+        for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
+          for (const int v : neighbours[w.row()])
+            out.insert(out.end(), row_inner + row_outer[v], row_inner + row_outer[v + 1]);
       });
+  {
+    SparseMatrixd pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
+    m_pattern.swap(pattern);  // Eigen's assignment from a named matrix would copy it
+  }
   if (9 * layer.indices.size() > std::size_t(std::numeric_limits<int>::max()))
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
 
@@ -285,24 +340,30 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
   m_block_targets.resize(3 * layer.indices.size());
   m_weighted_targets.resize(first_weighted[num_mesh_vertices]);
-  // Per thread: the slot of each DOF vertex in one list of `blocks` (−1 elsewhere), and the slots
-  // of one vertex's targets.
+  // Per thread: the slot of each DOF vertex in the lists of `blocks` of w's row entries (up to
+  // kMarked of them; −1 elsewhere), and the slots of one vertex's targets.
+  constexpr int kMarked = 4;
   tbb::enumerable_thread_specific<std::vector<int>> slots_of(
-      [&] { return std::vector<int>(m_num_dof_vertices, -1); });
+      [&] { return std::vector<int>(kMarked * m_num_dof_vertices, -1); });
   tbb::enumerable_thread_specific<std::vector<Index>> target_slots;
   tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
     const std::span<const int> list = layer[w];
     if (list.empty()) return;
-    // A DOF vertex b of w's row (the only one unless w hangs) and the slots in its list.
-    const bool single = row_outer[w + 1] - row_outer[w] == 1;
-    std::vector<int>& slot_of = slots_of.local();
-    const std::span<const int> single_list = blocks[row_inner[row_outer[w]]];
-    if (single)
-      for (std::size_t k = 0; k < single_list.size(); ++k)
-        slot_of[single_list[k]] = static_cast<int>(k);
-    auto slot = [&](int a, int b) -> Index {
-      if (single) return slot_of[a];
-      const std::span<const int> b_list = blocks[b];
+    // The DOF vertices b of w's row (one unless w hangs) and the slots in their lists.
+    const int first_b = row_outer[w];
+    const int num_b = row_outer[w + 1] - first_b;
+    const bool marked = num_b <= kMarked;
+    int* slot_of = slots_of.local().data();
+    if (marked)
+      for (int k = 0; k < num_b; ++k) {
+        const std::span<const int> b_list = blocks[row_inner[first_b + k]];
+        int* marks = slot_of + k * m_num_dof_vertices;
+        for (std::size_t i = 0; i < b_list.size(); ++i)
+          marks[b_list[i]] = static_cast<int>(i);
+      }
+    auto slot = [&](int a, int ib) -> Index {
+      if (marked) return slot_of[(ib - first_b) * m_num_dof_vertices + a];
+      const std::span<const int> b_list = blocks[row_inner[ib]];
       return std::lower_bound(b_list.begin(), b_list.end(), a) - b_list.begin();
     };
     // The slots of the targets of every block (v, w), in the order (v, C_va, C_wb).
@@ -310,11 +371,14 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     slots.clear();
     for (const int v : list)
       for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
-        for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
-          slots.push_back(slot(row_inner[ia], row_inner[ib]));
-    if (single)
-      for (const int a : single_list)
-        slot_of[a] = -1;
+        for (int ib = first_b; ib < first_b + num_b; ++ib)
+          slots.push_back(slot(row_inner[ia], ib));
+    if (marked)
+      for (int k = 0; k < num_b; ++k) {
+        int* marks = slot_of + k * m_num_dof_vertices;
+        for (const int a : blocks[row_inner[first_b + k]])
+          marks[a] = -1;
+      }
     // The layer's values are column by column (3w + j), each holding the blocks of `list`.
     Index position = first_weighted[w];
     for (int j = 0; j < 3; ++j) {
