@@ -302,19 +302,26 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     const std::span<const int> dof_list = b_dof >= 0 ? blocks[b_dof] : std::span<const int>();
     for (std::size_t k = 0; k < dof_list.size(); ++k)
       dof_slot[dof_list[k]] = static_cast<int>(k);
+    const Index layer_start = block_column_start(layer, w, 0);
+    const Index layer_column = 3 * layer.list_size(w);
+    const Index dof_start = b_dof >= 0 ? block_column_start(blocks, b_dof, 0) : 0;
+    const Index dof_column = b_dof >= 0 ? 3 * blocks.list_size(b_dof) : 0;
+    int* all_offsets = m_offsets.data();
     for (const int t : incident[w]) {
-      const int* tet = &sorted_tets[4 * t];
-      const int b = static_cast<int>(std::find(tet, tet + 4, static_cast<int>(w)) - tet);
-      int* offsets = &m_offsets[48 * Index(t)];
-      for (int a = 0; a < 4; ++a) {
-        const Index start =
-            m_in_layer[t] ? block_column_start(layer, w, 0) + 3 * layer_slot[tet[a]]
-                          : block_column_start(blocks, b_dof, 0) + 3 * dof_slot[direct_dof[tet[a]]];
-        const Index column_length =
-            m_in_layer[t] ? 3 * layer.list_size(w) : 3 * blocks.list_size(b_dof);
+      const int corners[4] = {sorted_tets[4 * t], sorted_tets[4 * t + 1], sorted_tets[4 * t + 2],
+                              sorted_tets[4 * t + 3]};
+      const int b =
+          static_cast<int>(std::find(corners, corners + 4, static_cast<int>(w)) - corners);
+      const bool in_layer = m_in_layer[t];
+      const Index start = in_layer ? layer_start : dof_start;
+      const Index column_length = in_layer ? layer_column : dof_column;
+      int slots[4];
+      for (int a = 0; a < 4; ++a)
+        slots[a] = in_layer ? layer_slot[corners[a]] : dof_slot[direct_dof[corners[a]]];
+      int* offsets = all_offsets + 48 * Index(t);
+      for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 3; ++c)
-          offsets[12 * a + 3 * b + c] = static_cast<int>(start + c * column_length);
-      }
+          offsets[12 * a + 3 * b + c] = static_cast<int>(start + 3 * slots[a] + c * column_length);
     }
     for (const int v : layer_list)
       layer_slot[v] = -1;
