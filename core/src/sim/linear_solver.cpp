@@ -18,6 +18,8 @@ struct SpdSolver::Cycle {
   /// Uses A (same pattern) on the finest level from now on, where the cycle can.
   virtual void update_finest(const SparseMatrixd& A) = 0;
   virtual void apply(ConstRef<VectorXd> r, VectorXd& z) const = 0;
+  /// y = A x for the A of the last setup() or update_finest().
+  virtual void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const = 0;
   /// MultigridPreconditioner::widen_smoother_intervals.
   virtual void widen_smoother_intervals() = 0;
   virtual double setup_seconds() const = 0;
@@ -33,6 +35,9 @@ struct TreeCycle final : SpdSolver::Cycle {
   bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
   void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
+  void multiply(const SparseMatrixd&, ConstRef<VectorXd> x, VectorXd& y) const override {
+    preconditioner.multiply_finest(x, y);
+  }
   void widen_smoother_intervals() override { preconditioner.widen_smoother_intervals(); }
   double setup_seconds() const override { return preconditioner.setup_seconds(); }
   int num_levels() const override { return preconditioner.num_levels(); }
@@ -78,6 +83,12 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
   void update_finest(const SparseMatrixd& A) override { cycle->update_finest(A); }
   void widen_smoother_intervals() override { cycle->widen_smoother_intervals(); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { cycle->apply(r, z); }
+  void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const override {
+    if (cycle != nullptr)
+      cycle->multiply_finest(x, y);
+    else
+      symmetric_product(A, x, y);
+  }
   double setup_seconds() const override { return seconds; }
   int num_levels() const override { return cycle != nullptr ? cycle->num_levels() : 0; }
 };
@@ -304,7 +315,7 @@ int SpdSolver::multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, Vecto
   VectorXd p = z;
   double rz = r.dot(z);
   for (int k = 0; k < m_max_iterations; ++k) {
-    symmetric_product(A, p, Ap);
+    m_multigrid->multiply(A, p, Ap);
     const double curvature = p.dot(Ap);
     if (!(rz > 0.0)) return -3;  // the preconditioner, not A, is not positive definite
     if (!(curvature > 0.0)) return -2;

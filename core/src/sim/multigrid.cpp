@@ -1,5 +1,7 @@
 #include "strata/core/sim/multigrid.hpp"
 
+#include "strata/core/sim/block_matrix.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -223,6 +225,7 @@ double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal) {
 struct MultigridPreconditioner::Level {
   SparseMatrixd owned;               ///< coarse Galerkin operator (empty on the finest level)
   const SparseMatrixd* A = nullptr;  ///< the operator of this level
+  BlockSymmetricMatrix blocks;       ///< A by 3 × 3 blocks, where its pattern allows (products)
   VectorXd inverse_diagonal;
   double lambda_min = 0.0;  ///< Chebyshev interval of D⁻¹A
   double lambda_max = 0.0;
@@ -271,6 +274,10 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     m_levels[k]->owned.swap(coarse);  // Eigen's assignment from a named matrix would copy it
     m_levels[k]->A = &m_levels[k]->owned;
   }
+  // The levels whose operators multiply vectors: the smoothed ones and the finest (CG's).
+  for (int k = 1; k <= L; ++k)
+    m_levels[k]->blocks.assign(*m_levels[k]->A);
+  if (L == 0) m_levels[0]->blocks.assign(A);
   for (int k = 1; k <= L; ++k)
     setup_smoother(*m_levels[k]);
   m_sizes.clear();
@@ -293,6 +300,7 @@ void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {
   if (m_sizes.empty() || m_sizes.back() != A.rows())
     throw std::logic_error("MultigridPreconditioner::update_finest before setup or size change");
   finest.A = &A;
+  finest.blocks.assign(A);
   if (num_levels() == 1) return;
   // The new diagonal; the eigenvalue estimate of the setup stays (nearby matrices; a smoother
   // that no longer fits shows as a failed or non-positive PCG solve, and the caller sets up anew).
@@ -322,7 +330,7 @@ void MultigridPreconditioner::setup_smoother(Level& level) {
   double rz = r.dot(z);
   std::vector<double> alphas, betas;
   for (int it = 0; it < m_options.lanczos_iterations && rz > 0.0; ++it) {
-    symmetric_product(A, p, Ap);
+    multiply(level, p, Ap);
     const double curvature = p.dot(Ap);
     if (!(curvature > 0.0)) break;
     const double alpha = rz / curvature;
@@ -368,7 +376,6 @@ void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, Vect
                                      bool zero_start) const {
   // Chebyshev iteration for A x = b preconditioned by D, started from x (Saad, Iterative
   // Methods for Sparse Linear Systems, Alg. 12.1).
-  const SparseMatrixd& A = *level.A;
   const double theta = 0.5 * (level.lambda_max + level.lambda_min);
   const double delta = 0.5 * (level.lambda_max - level.lambda_min);
   const double sigma = theta / delta;
@@ -378,7 +385,7 @@ void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, Vect
   if (zero_start) {
     r = b;
   } else {
-    symmetric_product(A, x, r);
+    multiply(level, x, r);
     r = b - r;
   }
   d = level.inverse_diagonal.cwiseProduct(r) / theta;
@@ -386,7 +393,7 @@ void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, Vect
   for (int i = 0; i < m_options.smoothing_degree; ++i) {
     x += d;
     if (i + 1 == m_options.smoothing_degree) break;
-    symmetric_product(A, d, Ad);
+    multiply(level, d, Ad);
     r -= Ad;
     const double rho_next = 1.0 / (2.0 * sigma - rho);
     d = (rho_next * rho) * d + (2.0 * rho_next / delta) * level.inverse_diagonal.cwiseProduct(r);
@@ -404,12 +411,26 @@ void MultigridPreconditioner::cycle(int k, const VectorXd& b, VectorXd& x) const
   const SparseMatrixd& P = m_prolongations[k - 1];
   x.setZero(b.size());
   smooth(level, b, x, true);
-  symmetric_product(*level.A, x, level.r);
+  multiply(level, x, level.r);
   level.r = b - level.r;
   coarse.b.noalias() = P.transpose() * level.r;
   cycle(k - 1, coarse.b, coarse.x);
   x.noalias() += P * coarse.x;
   smooth(level, b, x, false);
+}
+
+void MultigridPreconditioner::multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y) {
+  if (level.blocks.empty())
+    symmetric_product(*level.A, x, y);
+  else
+    level.blocks.multiply(x, y);
+}
+
+void MultigridPreconditioner::multiply_finest(ConstRef<VectorXd> x, VectorXd& y) const {
+  const Level& finest = *m_levels.back();
+  if (finest.A == nullptr)
+    throw std::logic_error("MultigridPreconditioner::multiply_finest before setup");
+  multiply(finest, x, y);
 }
 
 void MultigridPreconditioner::apply(ConstRef<VectorXd> r, VectorXd& z) const {

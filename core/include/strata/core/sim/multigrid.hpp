@@ -87,6 +87,9 @@ class MultigridPreconditioner {
   void update_finest(const SparseMatrixd& A);
   /// z = one V-cycle applied to r.
   void apply(ConstRef<VectorXd> r, VectorXd& z) const;
+  /// y = A x for the finest operator of the last setup() or update_finest() (by 3 × 3 blocks
+  /// where its pattern has them, BlockSymmetricMatrix; else symmetric_product).
+  void multiply_finest(ConstRef<VectorXd> x, VectorXd& y) const;
   /// Every level's Chebyshev interval up to the row-sum (Gershgorin) bound of D⁻¹A, which holds
   /// for any matrix: for when a Lanczos estimate missed the top of a spectrum (a V-cycle that PCG
   /// finds indefinite). The smoothers then damp the whole spectrum and the cycle is positive
@@ -104,6 +107,7 @@ class MultigridPreconditioner {
   void setup_smoother(Level& level);
   void cycle(int k, const VectorXd& b, VectorXd& x) const;
   void smooth(const Level& level, const VectorXd& b, VectorXd& x, bool zero_start) const;
+  static void multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y);
 
   Options m_options;
   std::vector<SparseMatrixd> m_prolongations;

@@ -1,0 +1,35 @@
+#pragma once
+/// \file block_matrix.hpp
+/// A symmetric matrix of 3 × 3 blocks (a Newton system whose vertices have all three DOFs free),
+/// stored by block columns with each block's nine values together. Copied from a compressed
+/// matrix whose pattern is made of whole blocks, it multiplies a vector with one row index and
+/// one three-entry read of x per block, and reads its values as one stream: the products of CG
+/// and of the multigrid smoothers.
+#include <vector>
+
+#include "strata/core/common/types.hpp"
+
+namespace strata {
+
+class BlockSymmetricMatrix {
+ public:
+  /// Copies A (square, compressed, column-major, symmetric with both triangles) when its pattern
+  /// is made of whole 3 × 3 blocks: 3n columns, the columns 3b, 3b + 1, 3b + 2 holding the same
+  /// rows, which come in triples 3a, 3a + 1, 3a + 2. Returns false (and holds nothing) otherwise.
+  bool assign(const SparseMatrixd& A);
+  void clear();
+  bool empty() const { return m_num_blocks == 0; }
+  Index rows() const { return 3 * m_num_blocks; }
+
+  /// y = A x (A as assigned), in parallel over block columns; the result does not depend on the
+  /// thread count.
+  void multiply(ConstRef<VectorXd> x, VectorXd& y) const;
+
+ private:
+  Index m_num_blocks = 0;
+  std::vector<int> m_outer;       ///< block column b: blocks m_outer[b] .. m_outer[b + 1]
+  std::vector<int> m_block_rows;  ///< block row a of each block
+  std::vector<double> m_values;   ///< 9 per block: entry (i, j) at 3j + i
+};
+
+}  // namespace strata

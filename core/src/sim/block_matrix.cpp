@@ -1,0 +1,101 @@
+#include "strata/core/sim/block_matrix.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <functional>
+
+namespace strata {
+
+bool BlockSymmetricMatrix::assign(const SparseMatrixd& A) {
+  clear();
+  const Index n = A.cols();
+  if (!A.isCompressed() || A.rows() != n || n % 3 != 0) return false;
+  const Index num_blocks = n / 3;
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  const double* values = A.valuePtr();
+  // Three columns of one length, a multiple of 3.
+  m_outer.resize(num_blocks + 1);
+  m_outer[0] = 0;
+  for (Index b = 0; b < num_blocks; ++b) {
+    const int length = outer[3 * b + 1] - outer[3 * b];
+    if (length % 3 != 0 || outer[3 * b + 2] - outer[3 * b + 1] != length ||
+        outer[3 * b + 3] - outer[3 * b + 2] != length) {
+      clear();
+      return false;
+    }
+    m_outer[b + 1] = m_outer[b] + length / 3;
+  }
+  m_block_rows.resize(m_outer[num_blocks]);
+  m_values.resize(9 * static_cast<std::size_t>(m_outer[num_blocks]));
+  // The rows of each column in triples, the same in the three columns; copied as checked.
+  const bool blocked = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, num_blocks, 512), true,
+      [&](const tbb::blocked_range<Index>& range, bool ok) {
+        for (Index b = range.begin(); ok && b != range.end(); ++b) {
+          const int start = outer[3 * b];
+          const int length = outer[3 * b + 1] - start;
+          const int* rows0 = inner + start;
+          const int* rows1 = rows0 + length;
+          const int* rows2 = rows1 + length;
+          for (int k = 0; ok && k < length; k += 3) {
+            const int r = rows0[k];
+            ok = r % 3 == 0 && rows0[k + 1] == r + 1 && rows0[k + 2] == r + 2;
+            for (int i = 0; ok && i < 3; ++i)
+              ok = rows1[k + i] == r + i && rows2[k + i] == r + i;
+            const int block = m_outer[b] + k / 3;
+            m_block_rows[block] = r / 3;
+            double* entries = &m_values[9 * static_cast<std::size_t>(block)];
+            for (int j = 0; j < 3; ++j)
+              for (int i = 0; i < 3; ++i)
+                entries[3 * j + i] = values[start + j * length + k + i];
+          }
+        }
+        return ok;
+      },
+      std::logical_and<bool>());
+  if (!blocked) {
+    clear();
+    return false;
+  }
+  m_num_blocks = num_blocks;
+  return true;
+}
+
+void BlockSymmetricMatrix::clear() {
+  m_num_blocks = 0;
+  m_outer.clear();
+  m_block_rows.clear();
+  m_values.clear();
+}
+
+void BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y) const {
+  y.resize(rows());
+  const double* xs = x.data();
+  double* ys = y.data();
+  const int* outer = m_outer.data();
+  const int* block_rows = m_block_rows.data();
+  const double* values = m_values.data();
+  // Row 3b + j of the (symmetric) matrix is column 3b + j: entry (i, j) of each block of block
+  // column b times x at its block row.
+  tbb::parallel_for(tbb::blocked_range<Index>(0, m_num_blocks, 1024),
+                    [&](const tbb::blocked_range<Index>& r) {
+                      for (Index b = r.begin(); b != r.end(); ++b) {
+                        double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+                        for (int k = outer[b]; k < outer[b + 1]; ++k) {
+                          const double* xa = xs + 3 * static_cast<Index>(block_rows[k]);
+                          const double* entries = values + 9 * static_cast<std::size_t>(k);
+                          y0 += entries[0] * xa[0] + entries[1] * xa[1] + entries[2] * xa[2];
+                          y1 += entries[3] * xa[0] + entries[4] * xa[1] + entries[5] * xa[2];
+                          y2 += entries[6] * xa[0] + entries[7] * xa[1] + entries[8] * xa[2];
+                        }
+                        ys[3 * b] = y0;
+                        ys[3 * b + 1] = y1;
+                        ys[3 * b + 2] = y2;
+                      }
+                    });
+}
+
+}  // namespace strata

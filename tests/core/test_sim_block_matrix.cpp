@@ -1,0 +1,123 @@
+// BlockSymmetricMatrix (block_matrix.hpp): products against dense ones on stiffness-like block
+// patterns, and the patterns it must refuse.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "strata/core/sim/block_matrix.hpp"
+#include "strata/core/sim/multigrid.hpp"
+
+namespace strata {
+namespace {
+
+/// A random symmetric matrix of 3 × 3 blocks over `num_blocks` block rows: a dense diagonal block
+/// per block column and `per_column` random off-diagonal blocks (mirrored), every entry of a
+/// present block stored (some of them exact zeros, as assembled matrices hold).
+SparseMatrixd random_block_matrix(Index num_blocks, int per_column, std::mt19937& random) {
+  std::uniform_int_distribution<Index> index(0, num_blocks - 1);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  std::vector<Eigen::Triplet<double>> triplets;
+  auto add_block = [&](Index a, Index b) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        if (a == b && j < i) continue;  // a diagonal block: its upper triangle, mirrored
+        const double v = (i + j) % 4 == 3 ? 0.0 : value(random);
+        triplets.emplace_back(3 * a + i, 3 * b + j, v);
+        if (a != b || i != j) triplets.emplace_back(3 * b + j, 3 * a + i, v);
+      }
+  };
+  for (Index b = 0; b < num_blocks; ++b) {
+    add_block(b, b);
+    for (int k = 0; k < per_column; ++k) {
+      const Index a = index(random);
+      if (a != b) add_block(a, b);
+    }
+  }
+  SparseMatrixd A(3 * num_blocks, 3 * num_blocks);
+  A.setFromTriplets(triplets.begin(), triplets.end());  // duplicates summed: still whole blocks
+  return A;
+}
+
+TEST(BlockSymmetricMatrix, ProductMatchesDense) {
+  std::mt19937 random(7);
+  for (const Index num_blocks : {1, 5, 400, 700}) {
+    const SparseMatrixd A = random_block_matrix(num_blocks, 6, random);
+    BlockSymmetricMatrix blocks;
+    ASSERT_TRUE(blocks.assign(A)) << num_blocks;
+    EXPECT_EQ(blocks.rows(), A.rows());
+    ASSERT_EQ((Eigen::MatrixXd(A) - Eigen::MatrixXd(A).transpose()).norm(), 0.0);
+    const VectorXd x = VectorXd::Random(A.rows());
+    VectorXd y;
+    blocks.multiply(x, y);
+    const VectorXd expected = Eigen::MatrixXd(A) * x;
+    EXPECT_LE((y - expected).norm(), 1e-13 * expected.norm()) << num_blocks;
+    VectorXd scalar;
+    symmetric_product(A, x, scalar);
+    EXPECT_LE((y - scalar).norm(), 1e-13 * expected.norm()) << num_blocks;
+  }
+}
+
+TEST(BlockSymmetricMatrix, ValuesFollowAReassignment) {
+  std::mt19937 random(11);
+  SparseMatrixd A = random_block_matrix(50, 4, random);
+  BlockSymmetricMatrix blocks;
+  ASSERT_TRUE(blocks.assign(A));
+  A *= 2.5;
+  ASSERT_TRUE(blocks.assign(A));
+  const VectorXd x = VectorXd::Random(A.rows());
+  VectorXd y;
+  blocks.multiply(x, y);
+  const VectorXd expected = Eigen::MatrixXd(A) * x;
+  EXPECT_LE((y - expected).norm(), 1e-13 * expected.norm());
+}
+
+TEST(BlockSymmetricMatrix, RefusesPatternsWithoutWholeBlocks) {
+  std::mt19937 random(3);
+  const SparseMatrixd A = random_block_matrix(20, 3, random);
+  BlockSymmetricMatrix blocks;
+
+  // A DOF of one vertex eliminated (a Dirichlet condition on one coordinate).
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (Index j = 0; j < A.outerSize(); ++j)
+    for (SparseMatrixd::InnerIterator it(A, j); it; ++it)
+      if (it.row() != 4 && j != 4)
+        triplets.emplace_back(it.row() - (it.row() > 4), j - (j > 4), it.value());
+  SparseMatrixd reduced(A.rows() - 1, A.cols() - 1);
+  reduced.setFromTriplets(triplets.begin(), triplets.end());
+  EXPECT_FALSE(blocks.assign(reduced));
+  EXPECT_TRUE(blocks.empty());
+
+  // One entry of a diagonal block pruned: the three columns of block column 0 differ.
+  SparseMatrixd pruned = A;
+  pruned.prune([](Index i, Index j, double) { return !(i == 2 && j == 1); });
+  pruned.makeCompressed();
+  ASSERT_EQ(pruned.nonZeros(), A.nonZeros() - 1);
+  EXPECT_FALSE(blocks.assign(pruned));
+
+  // Columns of equal length whose rows are not whole blocks: block column 0 holds rows 0–2 and
+  // 4–6 (a block shifted by one row).
+  std::vector<Eigen::Triplet<double>> shifted;
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      shifted.emplace_back(i, j, 1.0);
+      shifted.emplace_back(4 + i, j, 1.0);
+    }
+  }
+  SparseMatrixd misaligned(9, 9);
+  misaligned.setFromTriplets(shifted.begin(), shifted.end());
+  EXPECT_FALSE(blocks.assign(misaligned));
+
+  // A matrix that is not square in blocks, and one left uncompressed.
+  EXPECT_FALSE(blocks.assign(SparseMatrixd(4, 4)));
+  SparseMatrixd uncompressed = A;
+  uncompressed.coeffRef(0, 0) += 1.0;
+  uncompressed.reserve(Eigen::VectorXi::Constant(A.cols(), 2));
+  EXPECT_FALSE(blocks.assign(uncompressed));
+
+  // Still usable afterwards.
+  EXPECT_TRUE(blocks.assign(A));
+  EXPECT_EQ(blocks.rows(), A.rows());
+}
+
+}  // namespace
+}  // namespace strata
