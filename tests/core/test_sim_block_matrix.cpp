@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/sim/block_matrix.hpp"
 #include "strata/core/sim/multigrid.hpp"
 
@@ -107,6 +108,27 @@ TEST(BlockSymmetricMatrix, RefusesPatternsWithoutWholeBlocks) {
   misaligned.setFromTriplets(shifted.begin(), shifted.end());
   EXPECT_FALSE(blocks.assign(misaligned));
 
+  // Columns of one length whose rows differ: column 1 of block column 0 holds block row 2 where
+  // columns 0 and 2 hold block row 1.
+  std::vector<Eigen::Triplet<double>> differing;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      differing.emplace_back(i, j, 1.0);
+      differing.emplace_back((j == 1 ? 6 : 3) + i, j, 1.0);
+    }
+  SparseMatrixd crossed(9, 9);
+  crossed.setFromTriplets(differing.begin(), differing.end());
+  EXPECT_FALSE(blocks.assign(crossed));
+
+  // A large matrix whose only fault is in its last block column (the check runs in ranges).
+  const SparseMatrixd large = random_block_matrix(3000, 4, random);
+  ASSERT_TRUE(blocks.assign(large));
+  SparseMatrixd faulty = large;
+  faulty.prune([&](Index i, Index j, double) { return !(i == j && j == large.cols() - 2); });
+  faulty.makeCompressed();
+  ASSERT_EQ(faulty.nonZeros(), large.nonZeros() - 1);
+  EXPECT_FALSE(blocks.assign(faulty));
+
   // A matrix that is not square in blocks, and one left uncompressed.
   EXPECT_FALSE(blocks.assign(SparseMatrixd(4, 4)));
   SparseMatrixd uncompressed = A;
@@ -117,6 +139,23 @@ TEST(BlockSymmetricMatrix, RefusesPatternsWithoutWholeBlocks) {
   // Still usable afterwards.
   EXPECT_TRUE(blocks.assign(A));
   EXPECT_EQ(blocks.rows(), A.rows());
+}
+
+TEST(BlockSymmetricMatrix, ProductDoesNotDependOnTheThreadCount) {
+  std::mt19937 random(5);
+  const SparseMatrixd A = random_block_matrix(6000, 8, random);
+  BlockSymmetricMatrix blocks;
+  ASSERT_TRUE(blocks.assign(A));
+  const VectorXd x = VectorXd::Random(A.rows());
+  VectorXd one, two, scalar;
+  set_thread_policy({.threads = 1});
+  blocks.multiply(x, one);
+  set_thread_policy({.threads = 2});
+  blocks.multiply(x, two);
+  set_thread_policy({});
+  EXPECT_EQ(one, two);
+  symmetric_product(A, x, scalar);
+  EXPECT_LE((one - scalar).norm(), 1e-13 * scalar.norm());
 }
 
 }  // namespace

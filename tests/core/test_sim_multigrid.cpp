@@ -98,6 +98,52 @@ TEST(Multigrid, FreeDofProlongationsDropConstrainedDofs) {
     for (const auto& e : t)
       full(3 * e.row() + c, 3 * e.col() + c) = e.value();
   EXPECT_EQ((Eigen::MatrixXd(dof[0]) - full.bottomRightCorner(8, 5)).cwiseAbs().maxCoeff(), 0.0);
+  // Stored as Eigen stores it from triplets: the same columns, rows in the same order.
+  const SparseMatrixd expected = full.bottomRightCorner(8, 5).sparseView();
+  ASSERT_EQ(dof[0].nonZeros(), expected.nonZeros());
+  EXPECT_TRUE(
+      std::equal(expected.outerIndexPtr(), expected.outerIndexPtr() + 6, dof[0].outerIndexPtr()));
+  EXPECT_TRUE(std::equal(expected.innerIndexPtr(), expected.innerIndexPtr() + expected.nonZeros(),
+                         dof[0].innerIndexPtr()));
+}
+
+TEST(Multigrid, FinestProductsFollowTheOperatorInUse) {
+  // Per coordinate: a scalar prolongation and SPD matrix, each taken ⊗ a 3 × 3 factor.
+  std::mt19937 random(9u);
+  auto kron = [](const SparseMatrixd& S, const Eigen::Matrix3d& B) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (Index j = 0; j < S.outerSize(); ++j)
+      for (SparseMatrixd::InnerIterator it(S, j); it; ++it)
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r)
+            triplets.emplace_back(3 * it.row() + r, 3 * j + c, it.value() * B(r, c));
+    SparseMatrixd K(3 * S.rows(), 3 * S.cols());
+    K.setFromTriplets(triplets.begin(), triplets.end());
+    return K;
+  };
+  const SparseMatrixd P = kron(random_prolongation(300, 60, random), Eigen::Matrix3d::Identity());
+  Eigen::Matrix3d B;
+  B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;  // SPD, with stored zeros in every block
+  const SparseMatrixd blocked = kron(random_spd(300, 4, random), B);
+  const SparseMatrixd scalar = random_spd(900, 6, random);  // no whole blocks
+  for (const SparseMatrixd* A : {&blocked, &scalar}) {
+    MultigridPreconditioner mg({P});
+    ASSERT_TRUE(mg.setup(*A));
+    const VectorXd x = VectorXd::Random(900);
+    const VectorXd Ax = *A * x;
+    VectorXd y;
+    mg.multiply_finest(*A, x, y);
+    EXPECT_LE((y - Ax).norm(), 1e-13 * Ax.norm());
+    // update_finest: the products follow the new operator.
+    const SparseMatrixd doubled = 2.0 * *A;
+    mg.update_finest(doubled);
+    mg.multiply_finest(doubled, x, y);
+    EXPECT_LE((y - 2.0 * Ax).norm(), 1e-13 * Ax.norm());
+    // A matrix other than the finest operator is multiplied as it is.
+    const SparseMatrixd tripled = 3.0 * *A;
+    mg.multiply_finest(tripled, x, y);
+    EXPECT_LE((y - 3.0 * Ax).norm(), 1e-13 * Ax.norm());
+  }
 }
 
 /// Prolongations of three levels, 80 → 400 → 2000 unknowns.

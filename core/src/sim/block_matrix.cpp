@@ -6,6 +6,8 @@
 
 #include <functional>
 
+#include "strata/core/common/error.hpp"
+
 namespace strata {
 
 bool BlockSymmetricMatrix::assign(const SparseMatrixd& A) {
@@ -72,6 +74,7 @@ void BlockSymmetricMatrix::clear() {
 }
 
 void BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y) const {
+  STRATA_VERIFY(x.size() == rows(), "BlockSymmetricMatrix::multiply: x has the wrong size");
   y.resize(rows());
   const double* xs = x.data();
   double* ys = y.data();

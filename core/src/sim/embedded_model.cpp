@@ -28,6 +28,8 @@ double rest_edge_length_mean(const ElasticModel& model) {
 std::pair<CompressedLists, CompressedLists> neighbour_lists(
     const CompressedLists& incident, const std::vector<int>& sorted_tets,
     const std::vector<std::uint8_t>& in_layer, Index num_vertices) {
+  STRATA_VERIFY(num_vertices <= std::numeric_limits<int>::max(),
+                "embedding: too many mesh vertices");
   std::pair<CompressedLists, CompressedLists> result;
   CompressedLists& all = result.first;
   CompressedLists& layer = result.second;
@@ -351,7 +353,7 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   // kMarked of them; −1 elsewhere), and the slots of one vertex's targets.
   constexpr int kMarked = 4;
   tbb::enumerable_thread_specific<std::vector<int>> slots_of(
-      [&] { return std::vector<int>(kMarked * m_num_dof_vertices, -1); });
+      [&] { return std::vector<int>(m_num_dof_vertices, -1); });
   tbb::enumerable_thread_specific<std::vector<Index>> target_slots;
   tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
     const std::span<const int> list = layer[w];
@@ -360,7 +362,10 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     const int first_b = row_outer[w];
     const int num_b = row_outer[w + 1] - first_b;
     const bool marked = num_b <= kMarked;
-    int* slot_of = slots_of.local().data();
+    std::vector<int>& marks_of = slots_of.local();  // more arrays only once a vertex hangs
+    if (marked && marks_of.size() < num_b * std::size_t(m_num_dof_vertices))
+      marks_of.resize(num_b * std::size_t(m_num_dof_vertices), -1);
+    int* slot_of = marks_of.data();
     if (marked)
       for (int k = 0; k < num_b; ++k) {
         const std::span<const int> b_list = blocks[row_inner[first_b + k]];

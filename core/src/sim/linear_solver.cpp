@@ -35,8 +35,8 @@ struct TreeCycle final : SpdSolver::Cycle {
   bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
   void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
-  void multiply(const SparseMatrixd&, ConstRef<VectorXd> x, VectorXd& y) const override {
-    preconditioner.multiply_finest(x, y);
+  void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const override {
+    preconditioner.multiply_finest(A, x, y);
   }
   void widen_smoother_intervals() override { preconditioner.widen_smoother_intervals(); }
   double setup_seconds() const override { return preconditioner.setup_seconds(); }
@@ -85,7 +85,7 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { cycle->apply(r, z); }
   void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const override {
     if (cycle != nullptr)
-      cycle->multiply_finest(x, y);
+      cycle->multiply_finest(A, x, y);
     else
       symmetric_product(A, x, y);
   }

@@ -1,7 +1,5 @@
 #include "strata/core/sim/multigrid.hpp"
 
-#include "strata/core/sim/block_matrix.hpp"
-
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -14,6 +12,8 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+
+#include "strata/core/sim/block_matrix.hpp"
 
 namespace strata {
 
@@ -267,6 +267,8 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     throw std::invalid_argument("MultigridPreconditioner::setup: matrix has " +
                                 std::to_string(A.rows()) + " rows, the finest level " +
                                 std::to_string(m_prolongations.back().rows()));
+  for (auto& level : m_levels)
+    level->blocks.clear();  // copied anew below, once every operator is in place
   m_levels[L]->A = &A;
   m_levels[L]->owned.resize(0, 0);
   for (int k = L - 1; k >= 0; --k) {
@@ -426,11 +428,13 @@ void MultigridPreconditioner::multiply(const Level& level, ConstRef<VectorXd> x,
     level.blocks.multiply(x, y);
 }
 
-void MultigridPreconditioner::multiply_finest(ConstRef<VectorXd> x, VectorXd& y) const {
+void MultigridPreconditioner::multiply_finest(const SparseMatrixd& A, ConstRef<VectorXd> x,
+                                              VectorXd& y) const {
   const Level& finest = *m_levels.back();
-  if (finest.A == nullptr)
-    throw std::logic_error("MultigridPreconditioner::multiply_finest before setup");
-  multiply(finest, x, y);
+  if (&A == finest.A)
+    multiply(finest, x, y);
+  else
+    symmetric_product(A, x, y);
 }
 
 void MultigridPreconditioner::apply(ConstRef<VectorXd> r, VectorXd& z) const {

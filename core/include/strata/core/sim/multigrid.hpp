@@ -80,16 +80,20 @@ class MultigridPreconditioner {
 
   /// Galerkin coarse operators of A (symmetric, both triangles), coarsest factorisation and
   /// smoothers. Returns false if the coarsest operator is not numerically positive definite.
-  /// A must outlive every later apply() (only a pointer is kept).
+  /// A must outlive every later apply(): a pointer to it is kept, and where its pattern has whole
+  /// 3 × 3 blocks a copy of its values for the products, so A's values must not change before
+  /// the next setup() or update_finest().
   bool setup(const SparseMatrixd& A);
-  /// Replaces the finest operator by A (same size) and its smoother's diagonal; the coarse levels
-  /// and the eigenvalue estimate of the last setup() stay (a preconditioner for nearby matrices).
+  /// Replaces the finest operator by A (same size; kept as setup() keeps it) and its smoother's
+  /// diagonal; the coarse levels and the eigenvalue estimate of the last setup() stay (a
+  /// preconditioner for nearby matrices).
   void update_finest(const SparseMatrixd& A);
   /// z = one V-cycle applied to r.
   void apply(ConstRef<VectorXd> r, VectorXd& z) const;
-  /// y = A x for the finest operator of the last setup() or update_finest() (by 3 × 3 blocks
-  /// where its pattern has them, BlockSymmetricMatrix; else symmetric_product).
-  void multiply_finest(ConstRef<VectorXd> x, VectorXd& y) const;
+  /// y = A x. When A is the finest operator of the last setup() or update_finest(), by the
+  /// 3 × 3-block copy those made of it where its pattern has whole blocks (BlockSymmetricMatrix);
+  /// otherwise by symmetric_product.
+  void multiply_finest(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const;
   /// Every level's Chebyshev interval up to the row-sum (Gershgorin) bound of D⁻¹A, which holds
   /// for any matrix: for when a Lanczos estimate missed the top of a spectrum (a V-cycle that PCG
   /// finds indefinite). The smoothers then damp the whole spectrum and the cycle is positive
