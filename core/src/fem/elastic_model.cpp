@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "batched_stiffness_kernels.hpp"
 #include "batched_stress_kernels.hpp"
@@ -157,6 +158,21 @@ double lane_group_forces(const LaneKernel& kernel, const double* positions, cons
   return energy;
 }
 
+/// Σ V ψ(F) over one lane group.
+template <typename LaneKernel>
+double lane_group_energy(const LaneKernel& kernel, const double* positions, const int* tets,
+                         const double* lane_Dm_inv, const double* volume) {
+  using detail::kLanes;
+  double F[3][3][kLanes];
+  detail::lane_deformation_gradient(positions, tets, lane_Dm_inv, F);
+  double P[3][3][kLanes], psi[kLanes];
+  kernel.template operator()<true>(F, P, psi);
+  double energy = 0.0;
+  for (int l = 0; l < kLanes; ++l)
+    energy += volume[l] * psi[l];
+  return energy;
+}
+
 /// The smallest volume ratio J over tets: the smallest J wins, a NaN before any number, ties to
 /// the smaller tet index, so the answer does not depend on the schedule.
 struct SmallestVolumeRatio {
@@ -259,10 +275,22 @@ void ElasticModel::accumulate_forces(const Kernel& kernel, ConstRef<VectorXd> x,
 double ElasticModel::energy(ConstRef<VectorXd> x) const {
   check_size(x, num_dofs());
   std::vector<double> chunk_energy(m_partition.num_chunks(), 0.0);
+  // Chunk by chunk, by lane groups where the model has a lane kernel, then a scalar tail.
   dispatch_kernel(m_material.model, m_lame, [&](const auto& kernel) {
+    using Kernel = std::decay_t<decltype(kernel)>;
     tbb::parallel_for(Index(0), m_partition.num_chunks(), [&](Index chunk) {
       double sum = 0.0;
-      for (int i = m_partition.chunk_begin[chunk]; i < m_partition.chunk_begin[chunk + 1]; ++i) {
+      int i = m_partition.chunk_begin[chunk];
+      const int end = m_partition.chunk_begin[chunk + 1];
+      if constexpr (requires { typename Kernel::LaneKernel; }) {
+        const typename Kernel::LaneKernel lanes(m_lame);
+        for (; i + detail::kLanes <= end; i += detail::kLanes) {
+          const double* lane_Dm_inv = &m_lane_rest[kLaneRest * (i / detail::kLanes)];
+          sum += lane_group_energy(lanes, x.data(), &m_sorted_tets[4 * i], lane_Dm_inv,
+                                   lane_Dm_inv + 9 * detail::kLanes);
+        }
+      }
+      for (; i < end; ++i) {
         const Eigen::Map<const Matrix3d> Dm_inv(&m_sorted_Dm_inv[9 * i]);
         sum += m_sorted_volume[i] *
                kernel.psi(edge_matrix_at(x.data(), &m_sorted_tets[4 * i]) * Dm_inv);
