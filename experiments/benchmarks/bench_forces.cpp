@@ -1,5 +1,6 @@
-// Internal-force evaluation f = −∂Ψ/∂x: throughput in tets/s (items_per_second) for each material
-// model, mesh size and thread count. Names: forces/<model>/tets:<#T>/threads:<n>.
+// Internal-force evaluation f = −∂Ψ/∂x and the elastic energy Ψ alone: throughput in tets/s
+// (items_per_second) for each material model, mesh size and thread count. Names:
+// forces/<model>/tets:<#T>/threads:<n> and energy/<model>/tets:<#T>/threads:<n>.
 #include <benchmark/benchmark.h>
 
 #include <strata/core/common/parallel.hpp>
@@ -23,6 +24,18 @@ void forces_benchmark(benchmark::State& state, MeshSize size, MaterialModel mate
   state.counters["threads"] = threads;
 }
 
+void energy_benchmark(benchmark::State& state, MeshSize size, MaterialModel material, int threads) {
+  const ThreadLimit limit(threads);
+  const ModelCase& c = model_case(size, material);
+  for (auto _ : state) {
+    double energy = c.model->energy(c.deformed);
+    benchmark::DoNotOptimize(energy);
+  }
+  state.SetItemsProcessed(state.iterations() * c.model->num_tets());
+  state.counters["tets"] = double(c.model->num_tets());
+  state.counters["threads"] = threads;
+}
+
 const bool registered = [] {
   for (const MeshSize& size : mesh_sizes())
     for (MaterialModel material : material_models())
@@ -30,6 +43,14 @@ const bool registered = [] {
         benchmark::RegisterBenchmark(
             benchmark_name("forces/" + to_string(material), size, threads).c_str(),
             forces_benchmark, size, material, threads)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+  for (const MeshSize& size : mesh_sizes())
+    for (MaterialModel material : material_models())
+      for (int threads : thread_counts())
+        benchmark::RegisterBenchmark(
+            benchmark_name("energy/" + to_string(material), size, threads).c_str(),
+            energy_benchmark, size, material, threads)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
   return true;

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Runs strata_benchmarks (built by .ci/setup.sh) and writes Google Benchmark JSON to
-# out/benchmarks/<group>.json, one file per group: forces, stiffness, implicit_euler_step.
+# out/benchmarks/<group>.json, one file per group: forces, energy, stiffness, implicit_euler_step.
 #
 # Usage: ./experiments/benchmarks/run_benchmarks.sh [group ...] [-- extra benchmark arguments]
-#   groups default to all three; STRATA_SKIP_SETUP=1 skips the setup/build step.
+#   groups default to all four; STRATA_SKIP_SETUP=1 skips the setup/build step.
 set -euo pipefail
 
 repo_root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -21,7 +21,7 @@ while (($# > 0)); do
   groups+=("$1")
   shift
 done
-((${#groups[@]} > 0)) || groups=(forces stiffness implicit_euler_step)
+((${#groups[@]} > 0)) || groups=(forces energy stiffness implicit_euler_step)
 
 if [[ "${STRATA_SKIP_SETUP:-0}" != "1" ]]; then
   "${repo_root}/.ci/setup.sh"

@@ -8,6 +8,7 @@
 #include "strata/core/common/parallel.hpp"
 #include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/fem/lumped_mass.hpp"
+#include "strata/core/fem/material_registry.hpp"
 #include "strata/core/fem/tet_element.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 
@@ -137,6 +138,34 @@ TEST_P(ElasticModelTest, StiffnessMatchesFiniteDifferenceOfForcesAndDenseAssembl
   }
 }
 
+TEST_P(ElasticModelTest, EnergyFollowsThePlasticInverse) {
+  // Σ V ψ(Ds Dm⁻¹ Fp⁻¹) per tet through the registry's ψ, for two plastic states in turn (the
+  // second replaces the first); 157 tets, so lane groups and a scalar tail.
+  TetMesh mesh = irregular_box(3, 12);
+  mesh.tets.conservativeResize(157, 4);
+  ElasticModel model(mesh.vertices, mesh.tets, test_material(GetParam()));
+  std::mt19937 rng(21);
+  const VectorXd x = randomly_deformed(model.rest_positions(), rng, 0.03);
+  const LameParameters lame = model.material().lame();
+  std::uniform_real_distribution<double> uniform(-0.05, 0.05);
+  for (int state = 0; state < 2; ++state) {
+    std::vector<Matrix3d> plastic_inverse(mesh.tets.rows());
+    for (Matrix3d& Fp_inv : plastic_inverse)
+      Fp_inv = Matrix3d::Identity() + Matrix3d::NullaryExpr([&] { return uniform(rng); });
+    model.set_plastic_inverse(plastic_inverse);
+    double expected = 0.0;
+    for (Index t = 0; t < mesh.tets.rows(); ++t) {
+      Matrix3d Ds;
+      for (int k = 0; k < 3; ++k)
+        Ds.col(k) = x.segment<3>(3 * mesh.tets(t, k + 1)) - x.segment<3>(3 * mesh.tets(t, 0));
+      const Matrix3d F = Ds * model.rest_data().Dm_inv[t] * plastic_inverse[t];
+      expected +=
+          model.rest_data().rest_volume[t] * material_traits(GetParam()).energy_density(F, lame);
+    }
+    EXPECT_NEAR(model.energy(x), expected, 1e-12 * std::abs(expected)) << "state " << state;
+  }
+}
+
 TEST_P(ElasticModelTest, ResultsAreBitwiseIdenticalForOneAndTwoThreads) {
   const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(2.0, 1.0, 1.0), {16, 8, 8});
   const ElasticModel model(mesh.vertices, mesh.tets, test_material(GetParam()));
@@ -144,18 +173,21 @@ TEST_P(ElasticModelTest, ResultsAreBitwiseIdenticalForOneAndTwoThreads) {
   const VectorXd x = randomly_deformed(model.rest_positions(), rng, 0.01);
   VectorXd f1, f2;
   SparseMatrixd K1, K2;
-  double e1, e2;
+  double e1, e2, energy1, energy2;
   {
     ThreadLimit limit(1);
     e1 = model.energy_and_forces(x, f1);
+    energy1 = model.energy(x);
     model.stiffness(x, K1, true);
   }
   {
     ThreadLimit limit(2);
     e2 = model.energy_and_forces(x, f2);
+    energy2 = model.energy(x);
     model.stiffness(x, K2, true);
   }
   EXPECT_EQ(e1, e2);
+  EXPECT_EQ(energy1, energy2);
   EXPECT_TRUE(f1 == f2);
   ASSERT_EQ(K1.nonZeros(), K2.nonZeros());
   EXPECT_TRUE(std::equal(K1.valuePtr(), K1.valuePtr() + K1.nonZeros(), K2.valuePtr()));
