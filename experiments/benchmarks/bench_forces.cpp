@@ -10,26 +10,20 @@
 namespace strata::bench {
 namespace {
 
-void forces_benchmark(benchmark::State& state, MeshSize size, MaterialModel material, int threads) {
+/// One evaluation per iteration: the forces (`energy` false) or the energy alone.
+void evaluation_benchmark(benchmark::State& state, MeshSize size, MaterialModel material,
+                          int threads, bool energy) {
   const ThreadLimit limit(threads);
   const ModelCase& c = model_case(size, material);
   VectorXd f(c.model->num_dofs());
   for (auto _ : state) {
-    c.model->forces(c.deformed, f);
-    benchmark::DoNotOptimize(f.data());
-    benchmark::ClobberMemory();
-  }
-  state.SetItemsProcessed(state.iterations() * c.model->num_tets());
-  state.counters["tets"] = double(c.model->num_tets());
-  state.counters["threads"] = threads;
-}
-
-void energy_benchmark(benchmark::State& state, MeshSize size, MaterialModel material, int threads) {
-  const ThreadLimit limit(threads);
-  const ModelCase& c = model_case(size, material);
-  for (auto _ : state) {
-    double energy = c.model->energy(c.deformed);
-    benchmark::DoNotOptimize(energy);
+    if (energy) {
+      benchmark::DoNotOptimize(c.model->energy(c.deformed));
+    } else {
+      c.model->forces(c.deformed, f);
+      benchmark::DoNotOptimize(f.data());
+      benchmark::ClobberMemory();
+    }
   }
   state.SetItemsProcessed(state.iterations() * c.model->num_tets());
   state.counters["tets"] = double(c.model->num_tets());
@@ -37,22 +31,16 @@ void energy_benchmark(benchmark::State& state, MeshSize size, MaterialModel mate
 }
 
 const bool registered = [] {
-  for (const MeshSize& size : mesh_sizes())
-    for (MaterialModel material : material_models())
-      for (int threads : thread_counts())
-        benchmark::RegisterBenchmark(
-            benchmark_name("forces/" + to_string(material), size, threads).c_str(),
-            forces_benchmark, size, material, threads)
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
-  for (const MeshSize& size : mesh_sizes())
-    for (MaterialModel material : material_models())
-      for (int threads : thread_counts())
-        benchmark::RegisterBenchmark(
-            benchmark_name("energy/" + to_string(material), size, threads).c_str(),
-            energy_benchmark, size, material, threads)
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime();
+  for (const bool energy : {false, true})
+    for (const MeshSize& size : mesh_sizes())
+      for (MaterialModel material : material_models())
+        for (int threads : thread_counts())
+          benchmark::RegisterBenchmark(
+              benchmark_name((energy ? "energy/" : "forces/") + to_string(material), size, threads)
+                  .c_str(),
+              evaluation_benchmark, size, material, threads, energy)
+              ->Unit(benchmark::kMillisecond)
+              ->UseRealTime();
   return true;
 }();
 

@@ -43,6 +43,13 @@ CompressedLists sorted_unique_lists(Index n, Index universe,
       lists.offsets[i + 1] = static_cast<Index>(out.size() - first);
     }
   });
+  join_chunk_lists(lists, chunk_indices);
+  return lists;
+}
+
+void join_chunk_lists(CompressedLists& lists, const std::vector<std::vector<int>>& chunk_indices) {
+  const Index n = lists.size();
+  const auto num_chunks = static_cast<Index>(chunk_indices.size());
   for (Index i = 0; i < n; ++i)
     lists.offsets[i + 1] += lists.offsets[i];
   lists.indices.resize(lists.offsets[n]);
@@ -51,7 +58,6 @@ CompressedLists sorted_unique_lists(Index n, Index universe,
     std::copy(chunk.begin(), chunk.end(),
               lists.indices.begin() + lists.offsets[n * c / num_chunks]);
   });
-  return lists;
 }
 
 CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets) {

@@ -36,7 +36,7 @@ std::pair<CompressedLists, CompressedLists> neighbour_lists(
   all.offsets.assign(num_vertices + 1, 0);
   layer.offsets.assign(num_vertices + 1, 0);
   if (num_vertices == 0) return result;
-  // Fixed chunks, each collecting its lists in buffers of its own; then one copy into place.
+  // Fixed chunks, each collecting its lists in buffers of its own (join_chunk_lists).
   const Index num_chunks = std::min<Index>(num_vertices, 256);
   std::vector<std::vector<int>> chunk_all(num_chunks), chunk_layer(num_chunks);
   struct Seen {
@@ -73,18 +73,8 @@ std::pair<CompressedLists, CompressedLists> neighbour_lists(
       layer.offsets[w + 1] = static_cast<Index>(out_layer.size() - first_layer);
     }
   });
-  for (Index w = 0; w < num_vertices; ++w) {
-    all.offsets[w + 1] += all.offsets[w];
-    layer.offsets[w + 1] += layer.offsets[w];
-  }
-  all.indices.resize(all.offsets[num_vertices]);
-  layer.indices.resize(layer.offsets[num_vertices]);
-  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
-    const Index begin = num_vertices * c / num_chunks;
-    std::copy(chunk_all[c].begin(), chunk_all[c].end(), all.indices.begin() + all.offsets[begin]);
-    std::copy(chunk_layer[c].begin(), chunk_layer[c].end(),
-              layer.indices.begin() + layer.offsets[begin]);
-  });
+  join_chunk_lists(all, chunk_all);
+  join_chunk_lists(layer, chunk_layer);
   return result;
 }
 

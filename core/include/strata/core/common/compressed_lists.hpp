@@ -29,6 +29,12 @@ struct CompressedLists {
 CompressedLists sorted_unique_lists(Index n, Index universe,
                                     const std::function<void(Index, std::vector<int>&)>& gather);
 
+/// Completes lists 0 … n − 1 (n = lists.size()) gathered in C = chunk_indices.size() fixed
+/// chunks: on entry lists.offsets[i + 1] holds the length of list i and chunk_indices[c] holds the
+/// lists [n c / C, n (c + 1) / C) back to back. Sums the offsets and copies the chunks into place
+/// (in parallel).
+void join_chunk_lists(CompressedLists& lists, const std::vector<std::vector<int>>& chunk_indices);
+
 /// The transpose of `lists` over `num_targets` targets: list j of the result holds, ascending,
 /// every i whose list holds j (as often as it does).
 CompressedLists transpose_lists(const CompressedLists& lists, Index num_targets);
