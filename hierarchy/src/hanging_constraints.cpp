@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <utility>
 
 #include "strata/core/common/error.hpp"
@@ -115,16 +116,18 @@ std::vector<HangingVertex> find_hanging_vertices(const TetTree& tree, const Flat
   // belongs to a finer active tet has no mesh vertex on its boundary, and only the others are
   // walked.
   const auto num_tets = static_cast<Index>(flat.tet_nodes.size());
-  std::vector<int> finest_level(num_vertices, 0);
+  STRATA_VERIFY(flat.tet_levels.size() == flat.tet_nodes.size(),
+                "find_hanging_vertices: flat mesh without tet levels");
+  std::vector<std::int8_t> finest_level(num_vertices, 0);
   for (Index t = 0; t < num_tets; ++t) {
-    const int level = tree.level(flat.tet_nodes[t]);
+    const std::int8_t level = flat.tet_levels[t];
     for (int k = 0; k < 4; ++k) {
-      int& finest = finest_level[flat.mesh.tets(t, k)];
+      std::int8_t& finest = finest_level[flat.mesh.tets(t, k)];
       finest = std::max(finest, level);
     }
   }
   const auto touches_finer = [&](Index t) {
-    const int level = tree.level(flat.tet_nodes[t]);
+    const std::int8_t level = flat.tet_levels[t];
     for (int k = 0; k < 4; ++k)
       if (finest_level[flat.mesh.tets(t, k)] > level) return true;
     return false;

@@ -81,19 +81,31 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
   const Index num_tets = mesh.tets.rows();
   const Index num_vertices = mesh.vertices.rows();
   const LameParameters lame = state.material.lame();
+  STRATA_VERIFY(static_cast<Index>(state.flat.tet_levels.size()) == num_tets,
+                "recovery_error_estimate: the flat mesh has no levels for its tets");
   const VectorXd volume = tet_rest_volumes(mesh);
   const auto& strain = state.fields.green_strain;
 
-  Eigen::Matrix<double, Eigen::Dynamic, 6> recovered =
-      Eigen::Matrix<double, Eigen::Dynamic, 6>::Zero(num_vertices, 6);
-  VectorXd weight = VectorXd::Zero(num_vertices);
-  for (Index t = 0; t < num_tets; ++t)
+  // Per vertex, row by row: the volume-weighted sum of its tets' strains, then their volume; the
+  // sum becomes the recovered (mean) strain.
+  using RowStrains = Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>;
+  RowStrains recovered = RowStrains::Zero(num_vertices, 7);
+  for (Index t = 0; t < num_tets; ++t) {
+    double weighted[7];
+    for (int c = 0; c < 6; ++c)
+      weighted[c] = volume[t] * strain(t, c);
+    weighted[6] = volume[t];
     for (int k = 0; k < 4; ++k) {
-      recovered.row(mesh.tets(t, k)) += volume[t] * strain.row(t);
-      weight[mesh.tets(t, k)] += volume[t];
+      double* sums = recovered.row(mesh.tets(t, k)).data();
+      for (int c = 0; c < 7; ++c)
+        sums[c] += weighted[c];
     }
-  for (Index v = 0; v < num_vertices; ++v)
-    if (weight[v] > 0.0) recovered.row(v) /= weight[v];
+  }
+  tbb::parallel_for(Index(0), num_vertices, kTetChunk, [&](Index begin) {
+    const Index end = std::min(begin + kTetChunk, num_vertices);
+    for (Index v = begin; v < end; ++v)
+      if (recovered(v, 6) > 0.0) recovered.row(v).head<6>() /= recovered(v, 6);
+  });
 
   RecoveryEstimate estimate;
   estimate.element_error_sq.resize(num_tets);
@@ -113,12 +125,12 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
       Vector6d sum = Vector6d::Zero();
       double vertex_terms = 0.0;
       for (int k = 0; k < 4; ++k) {
-        const Vector6d d = recovered.row(mesh.tets(t, k)).transpose() - own;
+        const Vector6d d = recovered.row(mesh.tets(t, k)).head<6>().transpose() - own;
         vertex_terms += twice_energy_density(d, lame);
         sum += d;
       }
       const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
-      const int level = state.tree.level(state.flat.tet_nodes[t]);
+      const int level = state.flat.tet_levels[t];
       estimate.element_error_sq[t] = error_sq * removed[level] * removed[level];
       estimate.element_raw_error_sq[t] = error_sq;
       load_work_terms[t] = error_sq * c_share[level];

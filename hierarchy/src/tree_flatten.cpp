@@ -1,8 +1,18 @@
 #include "strata/hierarchy/tree_flatten.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "strata/core/common/error.hpp"
 
 namespace strata {
+
+namespace {
+
+/// Vertices or tets per parallel task.
+constexpr int kChunk = 4096;
+
+}  // namespace
 
 FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes,
                            VertexNumbering numbering) {
@@ -22,20 +32,28 @@ FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes
   }
 
   flat.tree_vertices.resize(count);
+  for (std::size_t v = 0; v < flat.mesh_vertices.size(); ++v)
+    if (flat.mesh_vertices[v] >= 0) flat.tree_vertices[flat.mesh_vertices[v]] = static_cast<int>(v);
   flat.mesh.vertices.resize(count, 3);
-  for (std::size_t v = 0; v < flat.mesh_vertices.size(); ++v) {
-    const int mesh_vertex = flat.mesh_vertices[v];
-    if (mesh_vertex < 0) continue;
-    flat.tree_vertices[mesh_vertex] = static_cast<int>(v);
-    flat.mesh.vertices.row(mesh_vertex) = tree.vertex_position(static_cast<int>(v)).transpose();
-  }
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, count, kChunk), [&](const tbb::blocked_range<int>& r) {
+        for (int v = r.begin(); v < r.end(); ++v)
+          flat.mesh.vertices.row(v) = tree.vertex_position(flat.tree_vertices[v]).transpose();
+      });
 
-  flat.mesh.tets.resize(static_cast<Index>(nodes.size()), 4);
-  for (std::size_t t = 0; t < nodes.size(); ++t) {
-    const std::array<int, 4> vertices = tree.tet_vertices(nodes[t]);
-    for (int i = 0; i < 4; ++i)
-      flat.mesh.tets(static_cast<Index>(t), i) = flat.mesh_vertices[vertices[i]];
-  }
+  const Index num_tets = static_cast<Index>(nodes.size());
+  flat.mesh.tets.resize(num_tets, 4);
+  flat.tet_levels.resize(nodes.size());
+  tbb::parallel_for(
+      tbb::blocked_range<Index>(0, num_tets, kChunk), [&](const tbb::blocked_range<Index>& r) {
+        for (Index t = r.begin(); t < r.end(); ++t) {
+          const TetNode& record = tree.node(nodes[t]);
+          const std::array<int, 4> vertices = oriented_tet(record.vertices, record.orientation);
+          for (int i = 0; i < 4; ++i)
+            flat.mesh.tets(t, i) = flat.mesh_vertices[vertices[i]];
+          flat.tet_levels[t] = record.level;
+        }
+      });
   return flat;
 }
 

@@ -1,7 +1,9 @@
 #pragma once
+
 /// \file tree_flatten.hpp
 /// Flattening (OpenVDB LeafManager style): a list of tree nodes — the leaves, or any active cut —
 /// as a plain TetMesh that core's ElasticModel runs on, with the maps back to the tree.
+#include <cstdint>
 #include <vector>
 
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -14,8 +16,9 @@ struct FlatTreeMesh {
   /// #V × 3 rest positions and #T × 4 positively oriented tets (tree.tet_vertices order). Only
   /// vertices used by the tets appear, numbered as VertexNumbering says.
   TetMesh mesh;
-  std::vector<NodeId> tet_nodes;   ///< #T: the tree node of each tet
-  std::vector<int> tree_vertices;  ///< #V: the tree vertex id of each mesh vertex
+  std::vector<NodeId> tet_nodes;        ///< #T: the tree node of each tet
+  std::vector<std::int8_t> tet_levels;  ///< #T: the tree level of each tet's node
+  std::vector<int> tree_vertices;       ///< #V: the tree vertex id of each mesh vertex
   std::vector<int> mesh_vertices;  ///< tree.vertex_capacity(): mesh vertex of a tree vertex, or −1
 };
 
