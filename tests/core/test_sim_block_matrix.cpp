@@ -2,6 +2,7 @@
 // patterns, and the patterns it must refuse.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "strata/core/common/parallel.hpp"
@@ -156,6 +157,44 @@ TEST(BlockSymmetricMatrix, ProductDoesNotDependOnTheThreadCount) {
   EXPECT_EQ(one, two);
   symmetric_product(A, x, scalar);
   EXPECT_LE((one - scalar).norm(), 1e-13 * scalar.norm());
+}
+
+TEST(BlockSymmetricMatrix, AfterEachChunkSeesItsRowsAndSumsInChunkOrder) {
+  // y = A x with, after each chunk, y's rows set to y − x there and their squared norm returned:
+  // the rows the callback sees are the chunk's own, already computed, and the sum is the chunks'
+  // partial sums in order, at one and two threads alike.
+  std::mt19937 random(11);
+  const Index num_blocks = 5 * BlockSymmetricMatrix::kBlockChunk + 77;
+  const SparseMatrixd A = random_block_matrix(num_blocks, 6, random);
+  BlockSymmetricMatrix blocks;
+  ASSERT_TRUE(blocks.assign(A));
+  const VectorXd x = VectorXd::Random(A.rows());
+  VectorXd plain;
+  blocks.multiply(x, plain);
+  const VectorXd expected_y = plain - x;
+  double expected_sum = 0.0;
+  for (Index first = 0; first < num_blocks; first += BlockSymmetricMatrix::kBlockChunk) {
+    const Index rows = 3 * std::min(BlockSymmetricMatrix::kBlockChunk, num_blocks - first);
+    expected_sum += expected_y.segment(3 * first, rows).squaredNorm();
+  }
+  for (const int threads : {1, 2}) {
+    set_thread_policy({.threads = threads});
+    VectorXd y;
+    int misplaced = 0;
+    const double sum = blocks.multiply(x, y, [&](Index begin, Index end) {
+      if (begin % (3 * BlockSymmetricMatrix::kBlockChunk) != 0 || end > y.size()) ++misplaced;
+      y.segment(begin, end - begin) -= x.segment(begin, end - begin);
+      return y.segment(begin, end - begin).squaredNorm();
+    });
+    EXPECT_EQ(misplaced, 0) << threads;
+    EXPECT_EQ(y, expected_y) << threads;
+    EXPECT_EQ(sum, expected_sum) << threads;
+  }
+  set_thread_policy({});
+  // No callback: the plain product, and 0.
+  VectorXd y;
+  EXPECT_EQ(blocks.multiply(x, y, {}), 0.0);
+  EXPECT_EQ(y, plain);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // Simulation running on the embedded DOFs (equilibrium, restart continuity).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <random>
 
 #include "fem_test_utils.hpp"
@@ -18,11 +19,12 @@ namespace {
 /// A 2 × 1 × 1-cell box, 2 m long: the vertices of the middle plane x = 1 are tied to the
 /// midpoint of their neighbours at x = 0 and x = 2 (the "hanging" rule of a coarser neighbour).
 struct TiedBox {
-  TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(2, 1, 1), {2, 1, 1});
+  TetMesh mesh;
   SparseMatrixd C;
   std::vector<int> dof_vertices;
 
-  TiedBox() {
+  explicit TiedBox(std::array<int, 3> cells = {2, 1, 1})
+      : mesh(box_tet_mesh(Vector3d(0, 0, 0), Vector3d(2, 1, 1), cells)) {
     const Index n = mesh.vertices.rows();
     std::vector<int> dof_index(n, -1);
     for (Index v = 0; v < n; ++v)
@@ -129,6 +131,28 @@ TEST(EmbeddedElasticModel, ReducedStiffnessEqualsSparseTripleProduct) {
   embedded.stiffness(q, K_reduced, true);
   EXPECT_LT((expected - Eigen::MatrixXd(K_reduced)).lpNorm<Eigen::Infinity>(),
             1e-12 * expected.lpNorm<Eigen::Infinity>());
+}
+
+TEST(EmbeddedElasticModel, ExpandAndReduceAreTheProlongationAndItsTranspose) {
+  // x = P q and r = Pᵀ f (P = C ⊗ I₃ built independently), on a box tied at its middle plane
+  // and on a larger one whose vertices span several parallel chunks.
+  for (const std::array<int, 3> cells : {std::array<int, 3>{2, 1, 1}, {40, 10, 10}}) {
+    TiedBox box;
+    if (cells[0] != 2) box = TiedBox(cells);
+    const ElasticModel model(box.mesh.vertices, box.mesh.tets, test_material(MaterialModel::stvk));
+    const EmbeddedElasticModel embedded(model, box.C, box.dof_vertices);
+    const SparseMatrixd P = box.P();
+    const VectorXd q = VectorXd::Random(P.cols());
+    const VectorXd f = VectorXd::Random(P.rows());
+    const VectorXd x = P * q;
+    const VectorXd r = P.transpose() * f;
+    EXPECT_LE((embedded.expand(q) - x).lpNorm<Eigen::Infinity>(),
+              1e-15 * x.lpNorm<Eigen::Infinity>())
+        << cells[0];
+    EXPECT_LE((embedded.reduce(f) - r).lpNorm<Eigen::Infinity>(),
+              1e-14 * r.lpNorm<Eigen::Infinity>())
+        << cells[0];
+  }
 }
 
 TEST(EmbeddedElasticModel, RigidMotionOfDofsGivesNoForce) {

@@ -4,8 +4,10 @@
 // symmetric positive definite operator (what CG needs).
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <random>
 
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/sim/multigrid.hpp"
 
 namespace strata {
@@ -207,6 +209,44 @@ TEST(Multigrid, WideningTheSmoothersMakesAnIndefiniteCyclePositiveDefinite) {
   mg.apply(r, z);
   EXPECT_GT(r.dot(z), 0.0);
   expect_symmetric_positive_definite(mg, A.rows(), random);
+}
+
+TEST(Multigrid, ACoarseSpaceOfEverythingMakesTheCycleExact) {
+  // With P = I the coarse correction solves the residual left by the pre-smoother exactly, and
+  // the post-smoother, started from the solution, keeps it: z = A⁻¹ r to round-off. This checks
+  // the residual, the restriction, the correction and the post-smoother's start against a dense
+  // solve.
+  std::mt19937 random(13u);
+  const Index n = 3000;
+  const SparseMatrixd A = random_spd(n, 5, random);
+  SparseMatrixd identity(n, n);
+  identity.setIdentity();
+  MultigridPreconditioner mg({identity});
+  ASSERT_TRUE(mg.setup(A));
+  const VectorXd r = VectorXd::Random(n);
+  VectorXd z;
+  mg.apply(r, z);
+  const VectorXd exact = Eigen::MatrixXd(A).ldlt().solve(r);
+  EXPECT_LE((z - exact).norm(), 1e-10 * exact.norm());
+}
+
+TEST(Multigrid, CycleDoesNotDependOnTheThreadCount) {
+  // Levels large enough for many chunks, with a blocked finest operator and scalar coarse ones.
+  std::mt19937 random(17u);
+  const std::vector<SparseMatrixd> prolongations = {random_prolongation(4000, 800, random),
+                                                    random_prolongation(30000, 4000, random)};
+  const SparseMatrixd A = random_spd(30000, 6, random);
+  MultigridPreconditioner mg(prolongations);
+  ASSERT_TRUE(mg.setup(A));
+  const VectorXd r = VectorXd::Random(A.rows());
+  VectorXd one, two;
+  set_thread_policy({.threads = 1});
+  mg.apply(r, one);
+  set_thread_policy({.threads = 2});
+  mg.apply(r, two);
+  set_thread_policy({});
+  EXPECT_EQ(one, two);
+  EXPECT_GT(r.dot(one), 0.0);
 }
 
 }  // namespace

@@ -123,6 +123,54 @@ TEST(Newton, UnreachableResidualConvergesOnTheIncrement) {
             1e-8 * std::abs(tip_deflection(c, q_reference)));
 }
 
+TEST(Newton, AKeptWorkspaceGivesTheSameSolvesAsFreshMatrices) {
+  // Two load steps minimised with one workspace kept between the calls, against the same calls
+  // with matrices of their own: the same iterates to the bit. A workspace filled for another
+  // energy (another size) is started afresh.
+  const Cantilever c;
+  EnergySum energy(c.embedded->stiffness_pattern());
+  energy.emplace<ElasticTerm>(*c.embedded);
+  ExternalWorkTerm& work = energy.emplace<ExternalWorkTerm>(c.external);
+  const DofReduction reduction(c.embedded->stiffness_pattern(), c.constrained);
+  NewtonSettings settings;
+  settings.force_scale = c.external.norm();
+  settings.rest_positions = &c.model->rest_positions();
+
+  // Matrices of the same sizes and column lengths as this energy's, with other rows in each
+  // column: reused as they are, the Hessians would land in the wrong entries.
+  const auto shuffled = [](const SparseMatrixd& pattern) {
+    SparseMatrixd m = pattern;
+    for (Index j = 0; j < m.outerSize(); ++j) {
+      const int length = m.outerIndexPtr()[j + 1] - m.outerIndexPtr()[j];
+      for (int k = 0; k < length; ++k)
+        m.innerIndexPtr()[m.outerIndexPtr()[j] + k] = k;  // rows 0 … length − 1
+    }
+    return m;
+  };
+  SparseMatrixd reduced_pattern;
+  reduction.restrict_matrix(c.embedded->stiffness_pattern(), reduced_pattern);
+  const EnergySum other(c.embedded->stiffness_pattern());
+  NewtonWorkspace workspace;
+  workspace.hessian = shuffled(c.embedded->stiffness_pattern());
+  workspace.reduced_hessian = shuffled(reduced_pattern);
+  workspace.energy = &other;
+  workspace.reduction = &reduction;
+
+  SpdSolver kept_solver(LinearSolverKind::cholmod), fresh_solver(LinearSolverKind::cholmod);
+  VectorXd kept = c.model->rest_positions(), fresh = kept;
+  for (const double load : {0.5, 1.0}) {
+    work.set_load_factor(load);
+    const NewtonResult with_workspace =
+        newton_minimize(energy, reduction, kept_solver, settings, kept, &workspace);
+    const NewtonResult without = newton_minimize(energy, reduction, fresh_solver, settings, fresh);
+    ASSERT_TRUE(with_workspace.converged);
+    EXPECT_EQ(with_workspace.residuals, without.residuals) << "load " << load;
+    EXPECT_EQ(kept, fresh) << "load " << load;
+    EXPECT_EQ(workspace.energy, &energy);
+    EXPECT_EQ(workspace.reduced_hessian.rows(), reduction.num_free());
+  }
+}
+
 /// E = 0 with a gradient k (q − a) + δ (q − a)/‖q − a‖ of norm k‖q − a‖ + δ ≥ δ: Newton reaches
 /// q ≈ a, where no step can bring ‖g‖ below δ (a residual stalled at δ) and E cannot tell steps
 /// apart.

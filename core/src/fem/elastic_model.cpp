@@ -15,6 +15,7 @@
 #include "batched_stress_kernels.hpp"
 #include "material_models.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/vector_chunks.hpp"
 #include "strata/core/fem/deformation_gradient.hpp"
 #include "strata/core/fem/green_strain.hpp"
 #include "strata/core/fem/hyperelastic.hpp"
@@ -403,7 +404,9 @@ void ElasticModel::stiffness(ConstRef<VectorXd> x, SparseMatrixd& K, bool projec
                   K.outerIndexPtr()))
     K = pattern;
   else
-    std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
+    for_each_vector_chunk(K.nonZeros(), [&](Index begin, Index end) {
+      std::fill(K.valuePtr() + begin, K.valuePtr() + end, 0.0);
+    });
   stiffness_into(x, project_psd, {K.valuePtr(), m_block_offsets.data()});
 }
 

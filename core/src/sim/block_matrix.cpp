@@ -4,7 +4,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <functional>
+#include <vector>
 
 #include "strata/core/common/error.hpp"
 
@@ -74,6 +76,11 @@ void BlockSymmetricMatrix::clear() {
 }
 
 void BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y) const {
+  multiply(x, y, {});
+}
+
+double BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y,
+                                      const std::function<double(Index, Index)>& after) const {
   STRATA_VERIFY(x.size() == rows(), "BlockSymmetricMatrix::multiply: x has the wrong size");
   y.resize(rows());
   const double* xs = x.data();
@@ -81,24 +88,32 @@ void BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y) const {
   const int* outer = m_outer.data();
   const int* block_rows = m_block_rows.data();
   const double* values = m_values.data();
+  const Index num_chunks = (m_num_blocks + kBlockChunk - 1) / kBlockChunk;
+  std::vector<double> partial(static_cast<std::size_t>(after ? num_chunks : 0));
   // Row 3b + j of the (symmetric) matrix is column 3b + j: entry (i, j) of each block of block
   // column b times x at its block row.
-  tbb::parallel_for(tbb::blocked_range<Index>(0, m_num_blocks, 1024),
-                    [&](const tbb::blocked_range<Index>& r) {
-                      for (Index b = r.begin(); b != r.end(); ++b) {
-                        double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-                        for (int k = outer[b]; k < outer[b + 1]; ++k) {
-                          const double* xa = xs + 3 * static_cast<Index>(block_rows[k]);
-                          const double* entries = values + 9 * static_cast<std::size_t>(k);
-                          y0 += entries[0] * xa[0] + entries[1] * xa[1] + entries[2] * xa[2];
-                          y1 += entries[3] * xa[0] + entries[4] * xa[1] + entries[5] * xa[2];
-                          y2 += entries[6] * xa[0] + entries[7] * xa[1] + entries[8] * xa[2];
-                        }
-                        ys[3 * b] = y0;
-                        ys[3 * b + 1] = y1;
-                        ys[3 * b + 2] = y2;
-                      }
-                    });
+  tbb::parallel_for(Index(0), num_chunks, [&](Index chunk) {
+    const Index first = chunk * kBlockChunk;
+    const Index last = std::min(m_num_blocks, first + kBlockChunk);
+    for (Index b = first; b != last; ++b) {
+      double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+      for (int k = outer[b]; k < outer[b + 1]; ++k) {
+        const double* xa = xs + 3 * static_cast<Index>(block_rows[k]);
+        const double* entries = values + 9 * static_cast<std::size_t>(k);
+        y0 += entries[0] * xa[0] + entries[1] * xa[1] + entries[2] * xa[2];
+        y1 += entries[3] * xa[0] + entries[4] * xa[1] + entries[5] * xa[2];
+        y2 += entries[6] * xa[0] + entries[7] * xa[1] + entries[8] * xa[2];
+      }
+      ys[3 * b] = y0;
+      ys[3 * b + 1] = y1;
+      ys[3 * b + 2] = y2;
+    }
+    if (after) partial[chunk] = after(3 * first, 3 * last);
+  });
+  double sum = 0.0;
+  for (const double value : partial)
+    sum += value;
+  return sum;
 }
 
 }  // namespace strata

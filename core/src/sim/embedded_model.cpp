@@ -13,6 +13,8 @@
 
 #include "strata/core/common/compressed_lists.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
+#include "strata/core/common/vector_chunks.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
 
 namespace strata {
@@ -146,19 +148,31 @@ EmbeddedElasticModel::EmbeddedElasticModel(const ElasticModel& model,
 
 VectorXd EmbeddedElasticModel::expand(ConstRef<VectorXd> q) const {
   if (m_identity) return q;
+  // x_v = Σ_q C_vq q_q, vertex by vertex (the columns of Cᵀ), in parallel.
   VectorXd x(3 * m_C.rows());
-  const Eigen::Map<const Eigen::MatrixXd> qm(q.data(), 3, m_num_dof_vertices);
-  Eigen::Map<Eigen::MatrixXd> xm(x.data(), 3, m_C.rows());
-  xm.noalias() = qm * m_CT;  // (3 × #Q)(#Q × #V): x_v = Σ_q C_vq q_q
+  for_each_vector_chunk(m_C.rows(), [&](Index begin, Index end) {
+    for (Index v = begin; v < end; ++v) {
+      Vector3d sum = Vector3d::Zero();
+      for (SparseMatrixd::InnerIterator it(m_CT, v); it; ++it)
+        sum += it.value() * q.segment<3>(3 * it.index());
+      x.segment<3>(3 * v) = sum;
+    }
+  });
   return x;
 }
 
 VectorXd EmbeddedElasticModel::reduce(ConstRef<VectorXd> f) const {
   if (m_identity) return f;
+  // r_q = Σ_v C_vq f_v, DOF vertex by DOF vertex (the columns of C), in parallel.
   VectorXd r(3 * m_num_dof_vertices);
-  const Eigen::Map<const Eigen::MatrixXd> fm(f.data(), 3, m_C.rows());
-  Eigen::Map<Eigen::MatrixXd> rm(r.data(), 3, m_num_dof_vertices);
-  rm.noalias() = fm * m_C;  // r_q = Σ_v C_vq f_v
+  for_each_vector_chunk(m_num_dof_vertices, [&](Index begin, Index end) {
+    for (Index q = begin; q < end; ++q) {
+      Vector3d sum = Vector3d::Zero();
+      for (SparseMatrixd::InnerIterator it(m_C, q); it; ++it)
+        sum += it.value() * f.segment<3>(3 * it.index());
+      r.segment<3>(3 * q) = sum;
+    }
+  });
   return r;
 }
 
@@ -197,23 +211,36 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
                   K.outerIndexPtr()))
     K = m_pattern;
   double* values = K.valuePtr();
-  std::fill(values, values + K.nonZeros(), 0.0);
+  for_each_vector_chunk(
+      K.nonZeros(), [&](Index begin, Index end) { std::fill(values + begin, values + end, 0.0); });
   m_layer_values.assign(3 * m_block_targets.size(), 0.0);
   m_model->stiffness_into(expand(q), project_psd,
                           {values, m_offsets.data(), m_in_layer.data(), m_layer_values.data()});
-  const double* source = m_layer_values.data();
-  const WeightedTarget* weighted = m_weighted_targets.data();
-  for (const int target : m_block_targets) {
-    if (target >= 0) {
-      for (int i = 0; i < 3; ++i)
-        values[target + i] += source[i];
-    } else {
-      for (int n = 0; n < ~target; ++n, ++weighted)
-        for (int i = 0; i < 3; ++i)
-          values[weighted->target + i] += weighted->weight * source[i];
+  // The layer's blocks into their targets, in the order of the serial pass. Each thread takes
+  // the targets in its own range of K's values and walks the whole layer for them: every value
+  // receives its additions in the same order at any thread count.
+  const int num_ranges = std::max(1, std::min(max_threads(), 8));
+  const Index nonzeros = K.nonZeros();
+  tbb::parallel_for(0, num_ranges, [&](int range) {
+    const Index first = nonzeros * range / num_ranges;
+    const Index last = nonzeros * (range + 1) / num_ranges;
+    const auto mine = [&](int target) { return target >= first && target < last; };
+    const double* source = m_layer_values.data();
+    const WeightedTarget* weighted = m_weighted_targets.data();
+    for (const int target : m_block_targets) {
+      if (target >= 0) {
+        if (mine(target))
+          for (int i = 0; i < 3; ++i)
+            values[target + i] += source[i];
+      } else {
+        for (int n = 0; n < ~target; ++n, ++weighted)
+          if (mine(weighted->target))
+            for (int i = 0; i < 3; ++i)
+              values[weighted->target + i] += weighted->weight * source[i];
+      }
+      source += 3;
     }
-    source += 3;
-  }
+  });
 }
 
 void EmbeddedElasticModel::build_reduced_pattern() {

@@ -73,7 +73,8 @@ NewtonResult ImplicitEuler::step(double t, double h, VectorXd& x, VectorXd& v) {
                           std::abs(f_ext.dot(y)) +
                           0.5 / (h * h) * (y - x_tilde).dot(M.cwiseProduct(y - x_tilde));
 
-  const NewtonResult result = newton_minimize(m_energy, m_reduction, m_solver, settings, y);
+  const NewtonResult result =
+      newton_minimize(m_energy, m_reduction, m_solver, settings, y, &m_workspace);
   v = (y - x_start) / h;
   x = y;
   // Dirichlet velocities are the prescribed ones, not the difference quotient.

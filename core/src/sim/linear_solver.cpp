@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 
+#include "strata/core/common/vector_chunks.hpp"
 #include "strata/core/sim/algebraic_multigrid.hpp"
 
 namespace strata {
@@ -18,8 +20,10 @@ struct SpdSolver::Cycle {
   /// Uses A (same pattern) on the finest level from now on, where the cycle can.
   virtual void update_finest(const SparseMatrixd& A) = 0;
   virtual void apply(ConstRef<VectorXd> r, VectorXd& z) const = 0;
-  /// y = A x for the A of the last setup() or update_finest().
-  virtual void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const = 0;
+  /// y = A x for the A of the last setup() or update_finest(), then `after` on fixed ranges of
+  /// y's rows; returns the sum of its values (MultigridPreconditioner::multiply_finest).
+  virtual double multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+                          const std::function<double(Index, Index)>& after) const = 0;
   /// MultigridPreconditioner::widen_smoother_intervals.
   virtual void widen_smoother_intervals() = 0;
   virtual double setup_seconds() const = 0;
@@ -35,8 +39,9 @@ struct TreeCycle final : SpdSolver::Cycle {
   bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
   void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
-  void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const override {
-    preconditioner.multiply_finest(A, x, y);
+  double multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+                  const std::function<double(Index, Index)>& after) const override {
+    return preconditioner.multiply_finest(A, x, y, after);
   }
   void widen_smoother_intervals() override { preconditioner.widen_smoother_intervals(); }
   double setup_seconds() const override { return preconditioner.setup_seconds(); }
@@ -83,11 +88,11 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
   void update_finest(const SparseMatrixd& A) override { cycle->update_finest(A); }
   void widen_smoother_intervals() override { cycle->widen_smoother_intervals(); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { cycle->apply(r, z); }
-  void multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const override {
-    if (cycle != nullptr)
-      cycle->multiply_finest(A, x, y);
-    else
-      symmetric_product(A, x, y);
+  double multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+                  const std::function<double(Index, Index)>& after) const override {
+    if (cycle != nullptr) return cycle->multiply_finest(A, x, y, after);
+    symmetric_product(A, x, y);
+    return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
   }
   double setup_seconds() const override { return seconds; }
   int num_levels() const override { return cycle != nullptr ? cycle->num_levels() : 0; }
@@ -305,28 +310,40 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
 }
 
 int SpdSolver::multigrid_pcg(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
-  const double b_norm = b.norm();
-  x.setZero(b.size());
+  // The vector updates run over fixed chunks in parallel, fused with the product where they can
+  // (vector_chunks.hpp): the iterates are the same at any thread count.
+  const Index n = b.size();
+  const double b_norm = std::sqrt(chunked_dot(b, b));
+  x.setZero(n);
   if (b_norm == 0.0) return 0;
   const double target = m_relative_tolerance * b_norm;
   VectorXd r = b;
-  VectorXd z(b.size()), Ap(b.size());
+  VectorXd z(n), Ap(n);
   m_multigrid->apply(r, z);
   VectorXd p = z;
-  double rz = r.dot(z);
+  double rz = chunked_dot(r, z);
   for (int k = 0; k < m_max_iterations; ++k) {
-    m_multigrid->multiply(A, p, Ap);
-    const double curvature = p.dot(Ap);
+    const double curvature = m_multigrid->multiply(A, p, Ap, [&](Index begin, Index end) {
+      return p.segment(begin, end - begin).dot(Ap.segment(begin, end - begin));
+    });
     if (!(rz > 0.0)) return -3;  // the preconditioner, not A, is not positive definite
     if (!(curvature > 0.0)) return -2;
     const double alpha = rz / curvature;
-    x += alpha * p;
-    r -= alpha * Ap;
+    const double r_squared = sum_over_vector_chunks(n, [&](Index begin, Index end) {
+      const Index m = end - begin;
+      x.segment(begin, m) += alpha * p.segment(begin, m);
+      r.segment(begin, m) -= alpha * Ap.segment(begin, m);
+      return r.segment(begin, m).squaredNorm();
+    });
     ++m_cg_iterations;
-    if (r.norm() <= target) return x.allFinite() ? k + 1 : -1;
+    if (std::sqrt(r_squared) <= target) return x.allFinite() ? k + 1 : -1;
     m_multigrid->apply(r, z);
-    const double rz_next = r.dot(z);
-    p = z + (rz_next / rz) * p;
+    const double rz_next = chunked_dot(r, z);
+    const double beta = rz_next / rz;
+    for_each_vector_chunk(n, [&](Index begin, Index end) {
+      p.segment(begin, end - begin) =
+          z.segment(begin, end - begin) + beta * p.segment(begin, end - begin);
+    });
     rz = rz_next;
   }
   return -1;

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "strata/core/common/vector_chunks.hpp"
 #include "strata/core/sim/block_matrix.hpp"
 
 namespace strata {
@@ -229,7 +230,7 @@ struct MultigridPreconditioner::Level {
   VectorXd inverse_diagonal;
   double lambda_min = 0.0;  ///< Chebyshev interval of D⁻¹A
   double lambda_max = 0.0;
-  mutable VectorXd r, d, z, x, b;  ///< scratch of the cycle
+  mutable VectorXd r, d, d_next, z, x, b;  ///< scratch of the cycle
 };
 
 struct MultigridPreconditioner::Coarse {
@@ -248,6 +249,8 @@ MultigridPreconditioner::MultigridPreconditioner(std::vector<SparseMatrixd> prol
   for (std::size_t k = 0; k + 1 < m_prolongations.size(); ++k)
     if (m_prolongations[k + 1].cols() != m_prolongations[k].rows())
       throw std::invalid_argument("MultigridPreconditioner: prolongation sizes do not chain");
+  for (const SparseMatrixd& P : m_prolongations)
+    m_prolongation_rows.emplace_back(P);
   m_levels.resize(m_prolongations.size() + 1);
   for (auto& level : m_levels)
     level = std::make_unique<Level>();
@@ -306,10 +309,12 @@ void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {
   if (num_levels() == 1) return;
   // The new diagonal; the eigenvalue estimate of the setup stays (nearby matrices; a smoother
   // that no longer fits shows as a failed or non-positive PCG solve, and the caller sets up anew).
-  for (Index i = 0; i < A.rows(); ++i) {
-    const double d = A.coeff(i, i);
-    finest.inverse_diagonal[i] = d > 0.0 ? 1.0 / d : 0.0;
-  }
+  for_each_vector_chunk(A.rows(), [&](Index begin, Index end) {
+    for (Index i = begin; i < end; ++i) {
+      const double d = A.coeff(i, i);
+      finest.inverse_diagonal[i] = d > 0.0 ? 1.0 / d : 0.0;
+    }
+  });
 }
 
 void MultigridPreconditioner::setup_smoother(Level& level) {
@@ -377,30 +382,64 @@ void MultigridPreconditioner::widen_smoother_intervals() {
 void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, VectorXd& x,
                                      bool zero_start) const {
   // Chebyshev iteration for A x = b preconditioned by D, started from x (Saad, Iterative
-  // Methods for Sparse Linear Systems, Alg. 12.1).
+  // Methods for Sparse Linear Systems, Alg. 12.1), x = 0 when `zero_start` (x is then only
+  // sized). Each product's rows are updated right after they are computed, on the same thread:
+  // r −= A d, the next direction into d_next (d is still read by the product), x += d_next.
   const double theta = 0.5 * (level.lambda_max + level.lambda_min);
   const double delta = 0.5 * (level.lambda_max - level.lambda_min);
   const double sigma = theta / delta;
+  const Index n = b.size();
+  const VectorXd& D = level.inverse_diagonal;
   VectorXd& r = level.r;
   VectorXd& d = level.d;
   VectorXd& Ad = level.z;
+  VectorXd& d_next = level.d_next;
+  r.resize(n);
+  d.resize(n);
+  d_next.resize(n);
+  x.resize(n);
+  // The first direction d = D r / θ (x, when not zero, is read by its product and takes d with
+  // the next update).
+  const auto first_direction = [&](Index begin, Index end) {
+    const Index m = end - begin;
+    d.segment(begin, m) = D.segment(begin, m).cwiseProduct(r.segment(begin, m)) / theta;
+    if (zero_start) x.segment(begin, m) = d.segment(begin, m);
+    return 0.0;
+  };
   if (zero_start) {
-    r = b;
+    for_each_vector_chunk(n, [&](Index begin, Index end) {
+      r.segment(begin, end - begin) = b.segment(begin, end - begin);
+      first_direction(begin, end);
+    });
   } else {
-    multiply(level, x, r);
-    r = b - r;
+    multiply(level, x, r, [&](Index begin, Index end) {
+      r.segment(begin, end - begin) = b.segment(begin, end - begin) - r.segment(begin, end - begin);
+      return first_direction(begin, end);
+    });
   }
-  d = level.inverse_diagonal.cwiseProduct(r) / theta;
+  bool d_in_x = zero_start;
   double rho = 1.0 / sigma;
-  for (int i = 0; i < m_options.smoothing_degree; ++i) {
-    x += d;
-    if (i + 1 == m_options.smoothing_degree) break;
-    multiply(level, d, Ad);
-    r -= Ad;
+  for (int i = 1; i < m_options.smoothing_degree; ++i) {
     const double rho_next = 1.0 / (2.0 * sigma - rho);
-    d = (rho_next * rho) * d + (2.0 * rho_next / delta) * level.inverse_diagonal.cwiseProduct(r);
+    const double old_weight = rho_next * rho;
+    const double new_weight = 2.0 * rho_next / delta;
+    multiply(level, d, Ad, [&](Index begin, Index end) {
+      const Index m = end - begin;
+      if (!d_in_x) x.segment(begin, m) += d.segment(begin, m);
+      r.segment(begin, m) -= Ad.segment(begin, m);
+      d_next.segment(begin, m) = old_weight * d.segment(begin, m) +
+                                 new_weight * D.segment(begin, m).cwiseProduct(r.segment(begin, m));
+      x.segment(begin, m) += d_next.segment(begin, m);
+      return 0.0;
+    });
+    d.swap(d_next);
+    d_in_x = true;
     rho = rho_next;
   }
+  if (!d_in_x)
+    for_each_vector_chunk(n, [&](Index begin, Index end) {
+      x.segment(begin, end - begin) += d.segment(begin, end - begin);
+    });
 }
 
 void MultigridPreconditioner::cycle(int k, const VectorXd& b, VectorXd& x) const {
@@ -411,30 +450,55 @@ void MultigridPreconditioner::cycle(int k, const VectorXd& b, VectorXd& x) const
   const Level& level = *m_levels[k];
   const Level& coarse = *m_levels[k - 1];
   const SparseMatrixd& P = m_prolongations[k - 1];
-  x.setZero(b.size());
+  const auto& P_rows = m_prolongation_rows[k - 1];
   smooth(level, b, x, true);
-  multiply(level, x, level.r);
-  level.r = b - level.r;
-  coarse.b.noalias() = P.transpose() * level.r;
+  // The residual r = b − A x, restricted by Pᵀ (column by column of P).
+  multiply(level, x, level.r, [&](Index begin, Index end) {
+    level.r.segment(begin, end - begin) =
+        b.segment(begin, end - begin) - level.r.segment(begin, end - begin);
+    return 0.0;
+  });
+  coarse.b.resize(P.cols());
+  for_each_vector_chunk(P.cols(), [&](Index begin, Index end) {
+    for (Index j = begin; j < end; ++j) {
+      double sum = 0.0;
+      for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
+        sum += it.value() * level.r[it.index()];
+      coarse.b[j] = sum;
+    }
+  });
   cycle(k - 1, coarse.b, coarse.x);
-  x.noalias() += P * coarse.x;
+  // The coarse correction x += P x_c, row by row.
+  for_each_vector_chunk(P_rows.rows(), [&](Index begin, Index end) {
+    for (Index i = begin; i < end; ++i) {
+      double sum = 0.0;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(P_rows, i); it; ++it)
+        sum += it.value() * coarse.x[it.index()];
+      x[i] += sum;
+    }
+  });
   smooth(level, b, x, false);
 }
 
-void MultigridPreconditioner::multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y) {
-  if (level.blocks.empty())
-    symmetric_product(*level.A, x, y);
-  else
-    level.blocks.multiply(x, y);
+double MultigridPreconditioner::multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y,
+                                         const std::function<double(Index, Index)>& after) {
+  if (!level.blocks.empty()) return level.blocks.multiply(x, y, after);
+  symmetric_product(*level.A, x, y);
+  return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
 }
 
 void MultigridPreconditioner::multiply_finest(const SparseMatrixd& A, ConstRef<VectorXd> x,
                                               VectorXd& y) const {
+  multiply_finest(A, x, y, {});
+}
+
+double MultigridPreconditioner::multiply_finest(
+    const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+    const std::function<double(Index, Index)>& after) const {
   const Level& finest = *m_levels.back();
-  if (&A == finest.A)
-    multiply(finest, x, y);
-  else
-    symmetric_product(A, x, y);
+  if (&A == finest.A) return multiply(finest, x, y, after);
+  symmetric_product(A, x, y);
+  return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
 }
 
 void MultigridPreconditioner::apply(ConstRef<VectorXd> r, VectorXd& z) const {

@@ -102,10 +102,19 @@ double internal_force_roundoff(const EmbeddedElasticModel& model) {
 }
 
 NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& reduction,
-                             SpdSolver& solver, const NewtonSettings& settings, VectorXd& x) {
+                             SpdSolver& solver, const NewtonSettings& settings, VectorXd& x,
+                             NewtonWorkspace* workspace) {
   NewtonResult result;
   VectorXd gradient(x.size()), trial_gradient(x.size());
-  SparseMatrixd hessian, reduced_hessian;
+  NewtonWorkspace local;
+  NewtonWorkspace& kept = workspace != nullptr ? *workspace : local;
+  if (kept.energy != &objective || kept.reduction != &reduction) {
+    kept = NewtonWorkspace();
+    kept.energy = &objective;
+    kept.reduction = &reduction;
+  }
+  SparseMatrixd& hessian = kept.hessian;
+  SparseMatrixd& reduced_hessian = kept.reduced_hessian;
   VectorXd step;
   objective.gradient(x, gradient);
   VectorXd g = reduction.restrict_vector(gradient);

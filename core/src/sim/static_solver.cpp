@@ -63,7 +63,7 @@ NewtonResult StaticSolver::solve(double load_factor, VectorXd& q) {
   const LameParameters lame = model.material().lame();
   settings.energy_scale =
       (2 * lame.mu + lame.lambda) * model.total_rest_volume() + std::abs(s_f * f_ext.dot(q));
-  return newton_minimize(m_energy, m_reduction, m_solver, settings, q);
+  return newton_minimize(m_energy, m_reduction, m_solver, settings, q, &m_workspace);
 }
 
 }  // namespace strata

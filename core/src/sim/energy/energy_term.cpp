@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/vector_chunks.hpp"
 
 namespace strata {
 
@@ -76,9 +77,14 @@ void DiagonalPositions::add(double scale, ConstRef<VectorXd> weights, SparseMatr
   // Kept while they are still the diagonal's in this matrix's index arrays, whichever matrix it
   // is (Eigen also reuses arrays for another pattern of the same size on assignment).
   bool cached = target.rows() == m_size && target.nonZeros() == m_non_zeros;
-  for (Index i = 0; cached && i < m_size; ++i)
-    cached =
-        m_positions[i] >= outer[i] && m_positions[i] < outer[i + 1] && inner[m_positions[i]] == i;
+  if (cached)
+    cached = sum_over_vector_chunks(m_size, [&](Index begin, Index end) {
+               for (Index i = begin; i < end; ++i)
+                 if (!(m_positions[i] >= outer[i] && m_positions[i] < outer[i + 1] &&
+                       inner[m_positions[i]] == i))
+                   return 1.0;
+               return 0.0;
+             }) == 0.0;
   if (!cached) {
     std::vector<Index> positions(target.outerSize());
     for (Index i = 0; i < target.outerSize(); ++i) {
@@ -95,10 +101,13 @@ void DiagonalPositions::add(double scale, ConstRef<VectorXd> weights, SparseMatr
   }
   // The products are rounded before the sums (no fused multiply-add): the values are those of
   // add_diagonal, and a term's additions commute with the other terms' as EnergySum assumes.
-  m_scaled = scale * weights;
+  m_scaled.resize(m_size);
   double* values = target.valuePtr();
-  for (Index i = 0; i < m_size; ++i)
-    values[m_positions[i]] += m_scaled[i];
+  for_each_vector_chunk(m_size, [&](Index begin, Index end) {
+    m_scaled.segment(begin, end - begin) = scale * weights.segment(begin, end - begin);
+    for (Index i = begin; i < end; ++i)
+      values[m_positions[i]] += m_scaled[i];
+  });
 }
 
 }  // namespace strata

@@ -5,6 +5,7 @@
 /// matrix whose pattern is made of whole blocks, it multiplies a vector with one row index and
 /// one three-entry read of x per block, and reads its values as one stream: the products of CG
 /// and of the multigrid smoothers.
+#include <functional>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -21,9 +22,18 @@ class BlockSymmetricMatrix {
   bool empty() const { return m_num_blocks == 0; }
   Index rows() const { return 3 * m_num_blocks; }
 
+  /// Block columns per parallel chunk of the products.
+  static constexpr Index kBlockChunk = 512;
+
   /// y = A x (A as assigned), in parallel over block columns; the result does not depend on the
   /// thread count.
   void multiply(ConstRef<VectorXd> x, VectorXd& y) const;
+  /// y = A x, and after each chunk of kBlockChunk block columns, on the thread that computed it,
+  /// `after(begin, end)` on the rows [begin, end) of y just written (which it may change, but no
+  /// entry of x, which other chunks read). Returns the sum of its values, added chunk by chunk
+  /// in order: the same at any thread count (0 for an empty `after`).
+  double multiply(ConstRef<VectorXd> x, VectorXd& y,
+                  const std::function<double(Index, Index)>& after) const;
 
  private:
   Index m_num_blocks = 0;

@@ -39,6 +39,7 @@ class ImplicitEuler {
   DofReduction m_reduction;
   NewtonControls m_controls;
   EnergySum m_energy;
+  NewtonWorkspace m_workspace;  ///< the Hessians, kept from step to step
   ExternalWorkTerm* m_external = nullptr;
   VectorXd m_timed_external;  ///< f_ext(t + h) when loads follow amplitudes
   InertiaTerm* m_inertia = nullptr;

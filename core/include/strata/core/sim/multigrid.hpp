@@ -21,6 +21,7 @@
 /// when λ_max(D⁻¹A) < 1.25 λ̂ (the polynomial's bound). The Lanczos estimate is within a few
 /// per cent in practice; a cycle that is not positive definite shows as rᵀz ≤ 0 in PCG, which sets
 /// up anew. Matrix–vector products and the smoothers run on TBB threads.
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -94,6 +95,10 @@ class MultigridPreconditioner {
   /// 3 × 3-block copy those made of it where its pattern has whole blocks (BlockSymmetricMatrix);
   /// otherwise by symmetric_product.
   void multiply_finest(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y) const;
+  /// The same, then `after(begin, end)` on fixed ranges of rows of y, in parallel (see
+  /// BlockSymmetricMatrix::multiply); returns the sum of its values in range order.
+  double multiply_finest(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+                         const std::function<double(Index, Index)>& after) const;
   /// Every level's Chebyshev interval up to the row-sum (Gershgorin) bound of D⁻¹A, which holds
   /// for any matrix: for when a Lanczos estimate missed the top of a spectrum (a V-cycle that PCG
   /// finds indefinite). The smoothers then damp the whole spectrum and the cycle is positive
@@ -111,10 +116,13 @@ class MultigridPreconditioner {
   void setup_smoother(Level& level);
   void cycle(int k, const VectorXd& b, VectorXd& x) const;
   void smooth(const Level& level, const VectorXd& b, VectorXd& x, bool zero_start) const;
-  static void multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y);
+  static double multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y,
+                         const std::function<double(Index, Index)>& after = {});
 
   Options m_options;
   std::vector<SparseMatrixd> m_prolongations;
+  /// The prolongations by rows, for the coarse corrections' products in parallel.
+  std::vector<Eigen::SparseMatrix<double, Eigen::RowMajor, int>> m_prolongation_rows;
   std::vector<std::unique_ptr<Level>> m_levels;  ///< coarsest first; finest last
   std::unique_ptr<Coarse> m_coarse;
   std::vector<Index> m_sizes;  ///< unknowns per level at the last setup

@@ -83,12 +83,25 @@ struct NewtonResult {
 /// of F ≈ I times a face area, accumulated over the DOFs.
 double internal_force_roundoff(const EmbeddedElasticModel& model);
 
+/// The matrices newton_minimize fills in every iteration. A caller that minimises the same
+/// energy again and again (a time stepper) keeps one and passes it to each call: the Hessians'
+/// patterns are then copied and their memory touched once, not once per call.
+struct NewtonWorkspace {
+  SparseMatrixd hessian;          ///< of the energy, all DOFs
+  SparseMatrixd reduced_hessian;  ///< restricted to the free DOFs
+  /// The energy and reduction the matrices were filled for; a call with others starts afresh.
+  const void* energy = nullptr;
+  const void* reduction = nullptr;
+};
+
 /// Minimises `energy` from the initial guess `q` (3·#Q, updated in place). Each iteration:
 /// gradient, Hessian (exact, else projected), reduce to free DOFs, solve H Δ = −g (on failure of
 /// the projected system, retry with a growing diagonal shift), then backtrack α = 1, ½, ¼, ...
 /// until E(q + αΔ) ≤ E(q) + 10⁻⁴ α gᵀΔ. When the decrease is below E's round-off (see
 /// energy_scale) or backtracking fails, the full step is taken if it lowers ‖g_free‖.
+/// `workspace`: kept between calls (see NewtonWorkspace); null: matrices local to this call.
 NewtonResult newton_minimize(const EnergySum& energy, const DofReduction& reduction,
-                             SpdSolver& solver, const NewtonSettings& settings, VectorXd& q);
+                             SpdSolver& solver, const NewtonSettings& settings, VectorXd& q,
+                             NewtonWorkspace* workspace = nullptr);
 
 }  // namespace strata

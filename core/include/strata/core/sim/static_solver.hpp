@@ -46,6 +46,7 @@ class StaticSolver {
   DofReduction m_reduction;
   NewtonControls m_controls;
   EnergySum m_energy;
+  NewtonWorkspace m_workspace;  ///< the Hessians, kept from step to step
   ExternalWorkTerm* m_external = nullptr;
   ContactTerm* m_contact = nullptr;
   VectorXd m_contact_reference;
