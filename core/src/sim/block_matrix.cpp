@@ -13,9 +13,14 @@
 namespace strata {
 
 bool BlockSymmetricMatrix::assign(const SparseMatrixd& A) {
-  clear();
+  // The arrays keep their size from the last copy: a matrix of the same pattern (the next Newton
+  // system) overwrites them without a fill.
+  m_num_blocks = 0;
   const Index n = A.cols();
-  if (!A.isCompressed() || A.rows() != n || n % 3 != 0) return false;
+  if (!A.isCompressed() || A.rows() != n || n % 3 != 0) {
+    clear();
+    return false;
+  }
   const Index num_blocks = n / 3;
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
