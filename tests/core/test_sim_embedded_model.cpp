@@ -3,11 +3,13 @@
 // Simulation running on the embedded DOFs (equilibrium, restart continuity).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <random>
 
 #include "fem_test_utils.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/embedded_model.hpp"
@@ -152,6 +154,27 @@ TEST(EmbeddedElasticModel, ExpandAndReduceAreTheProlongationAndItsTranspose) {
     EXPECT_LE((embedded.reduce(f) - r).lpNorm<Eigen::Infinity>(),
               1e-14 * r.lpNorm<Eigen::Infinity>())
         << cells[0];
+  }
+}
+
+TEST(EmbeddedElasticModel, ReducedStiffnessDoesNotDependOnTheThreadCount) {
+  // The layer of tets at the tied vertices adds into K by value ranges, one per thread: K is the
+  // same to the bit at 1, 2 and 8 threads.
+  const TiedBox box({40, 10, 10});
+  const ElasticModel model(box.mesh.vertices, box.mesh.tets, test_material(MaterialModel::stvk));
+  const EmbeddedElasticModel embedded(model, box.C, box.dof_vertices);
+  const VectorXd q = perturbed(embedded.rest_positions(), 0.01, 5);
+  std::vector<SparseMatrixd> K(3);
+  const int threads[3] = {1, 2, 8};
+  for (int i = 0; i < 3; ++i) {
+    set_thread_policy({.threads = threads[i]});
+    embedded.stiffness(q, K[i], false);
+  }
+  set_thread_policy({});
+  for (int i = 1; i < 3; ++i) {
+    ASSERT_EQ(K[i].nonZeros(), K[0].nonZeros());
+    EXPECT_TRUE(std::equal(K[0].valuePtr(), K[0].valuePtr() + K[0].nonZeros(), K[i].valuePtr()))
+        << threads[i] << " threads";
   }
 }
 

@@ -6,6 +6,8 @@
 
 #include <Eigen/Dense>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "strata/core/common/parallel.hpp"
 #include "strata/core/sim/multigrid.hpp"
@@ -49,6 +51,19 @@ SparseMatrixd random_prolongation(Index fine, Index coarse, std::mt19937& random
   SparseMatrixd P(fine, coarse);
   P.setFromTriplets(triplets.begin(), triplets.end());
   return P;
+}
+
+/// S ⊗ B: each entry of S times the 3 × 3 block B (whole 3 × 3 blocks, as stiffness matrices).
+SparseMatrixd kron3(const SparseMatrixd& S, const Eigen::Matrix3d& B) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (Index j = 0; j < S.outerSize(); ++j)
+    for (SparseMatrixd::InnerIterator it(S, j); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+          triplets.emplace_back(3 * it.row() + r, 3 * j + c, it.value() * B(r, c));
+  SparseMatrixd K(3 * S.rows(), 3 * S.cols());
+  K.setFromTriplets(triplets.begin(), triplets.end());
+  return K;
 }
 
 TEST(Multigrid, GalerkinProductMatchesEigen) {
@@ -112,21 +127,10 @@ TEST(Multigrid, FreeDofProlongationsDropConstrainedDofs) {
 TEST(Multigrid, FinestProductsFollowTheOperatorInUse) {
   // Per coordinate: a scalar prolongation and SPD matrix, each taken ⊗ a 3 × 3 factor.
   std::mt19937 random(9u);
-  auto kron = [](const SparseMatrixd& S, const Eigen::Matrix3d& B) {
-    std::vector<Eigen::Triplet<double>> triplets;
-    for (Index j = 0; j < S.outerSize(); ++j)
-      for (SparseMatrixd::InnerIterator it(S, j); it; ++it)
-        for (int c = 0; c < 3; ++c)
-          for (int r = 0; r < 3; ++r)
-            triplets.emplace_back(3 * it.row() + r, 3 * j + c, it.value() * B(r, c));
-    SparseMatrixd K(3 * S.rows(), 3 * S.cols());
-    K.setFromTriplets(triplets.begin(), triplets.end());
-    return K;
-  };
-  const SparseMatrixd P = kron(random_prolongation(300, 60, random), Eigen::Matrix3d::Identity());
+  const SparseMatrixd P = kron3(random_prolongation(300, 60, random), Eigen::Matrix3d::Identity());
   Eigen::Matrix3d B;
   B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;  // SPD, with stored zeros in every block
-  const SparseMatrixd blocked = kron(random_spd(300, 4, random), B);
+  const SparseMatrixd blocked = kron3(random_spd(300, 4, random), B);
   const SparseMatrixd scalar = random_spd(900, 6, random);  // no whole blocks
   for (const SparseMatrixd* A : {&blocked, &scalar}) {
     MultigridPreconditioner mg({P});
@@ -230,23 +234,123 @@ TEST(Multigrid, ACoarseSpaceOfEverythingMakesTheCycleExact) {
   EXPECT_LE((z - exact).norm(), 1e-10 * exact.norm());
 }
 
+/// The V-cycle written out serially with Eigen's own products (the textbook form the
+/// preconditioner implements): Galerkin operators PᵀAP, a dense solve on the coarsest level,
+/// `degree` Chebyshev steps in D⁻¹A on each level's interval (Saad, Alg. 12.1) before and after
+/// the coarse correction.
+class ReferenceCycle {
+ public:
+  ReferenceCycle(const SparseMatrixd& A, const std::vector<SparseMatrixd>& P,
+                 const MultigridPreconditioner& mg, int degree)
+      : m_P(P), m_degree(degree) {
+    m_A.resize(P.size() + 1);
+    m_A.back() = A;
+    for (int k = static_cast<int>(P.size()) - 1; k >= 0; --k)
+      m_A[k] = SparseMatrixd(P[k].transpose() * m_A[k + 1] * P[k]);
+    for (std::size_t k = 1; k < m_A.size(); ++k)
+      m_interval.push_back(mg.smoother_interval(static_cast<int>(k)));
+    m_coarse = Eigen::MatrixXd(m_A[0]).ldlt();
+  }
+  VectorXd apply(const VectorXd& b) const { return cycle(static_cast<int>(m_P.size()), b); }
+
+ private:
+  void smooth(int k, const VectorXd& b, VectorXd& x) const {
+    const SparseMatrixd& A = m_A[k];
+    const VectorXd inverse_diagonal = A.diagonal().cwiseInverse();
+    const auto [lambda_min, lambda_max] = m_interval[k - 1];
+    const double theta = 0.5 * (lambda_max + lambda_min);
+    const double delta = 0.5 * (lambda_max - lambda_min);
+    const double sigma = theta / delta;
+    VectorXd r = b - A * x;
+    VectorXd d = inverse_diagonal.cwiseProduct(r) / theta;
+    double rho = 1.0 / sigma;
+    for (int i = 0; i < m_degree; ++i) {
+      x += d;
+      if (i + 1 == m_degree) break;
+      r -= A * d;
+      const double rho_next = 1.0 / (2.0 * sigma - rho);
+      d = (rho_next * rho) * d + (2.0 * rho_next / delta) * inverse_diagonal.cwiseProduct(r);
+      rho = rho_next;
+    }
+  }
+  VectorXd cycle(int k, const VectorXd& b) const {
+    if (k == 0) return m_coarse.solve(b);
+    VectorXd x = VectorXd::Zero(b.size());
+    smooth(k, b, x);
+    const VectorXd coarse = cycle(k - 1, m_P[k - 1].transpose() * (b - m_A[k] * x));
+    x += m_P[k - 1] * coarse;
+    smooth(k, b, x);
+    return x;
+  }
+
+  std::vector<SparseMatrixd> m_A;
+  std::vector<SparseMatrixd> m_P;
+  std::vector<std::pair<double, double>> m_interval;
+  Eigen::LDLT<Eigen::MatrixXd> m_coarse;
+  int m_degree;
+};
+
+TEST(Multigrid, CycleIsTheTextbookVCycle) {
+  // Against the serial reference above, for smoothing degrees 1–3, on blocked operators (the
+  // fused block products, every level) and on scalar ones (the compressed-column products),
+  // with levels large enough for several chunks.
+  std::mt19937 random(19u);
+  Eigen::Matrix3d B;
+  B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;
+  const std::vector<SparseMatrixd> scalar_P = {random_prolongation(300, 60, random),
+                                               random_prolongation(2400, 300, random)};
+  const SparseMatrixd scalar_A = random_spd(2400, 6, random);
+  const std::vector<SparseMatrixd> blocked_P = {kron3(scalar_P[0], Eigen::Matrix3d::Identity()),
+                                                kron3(scalar_P[1], Eigen::Matrix3d::Identity())};
+  const SparseMatrixd blocked_A = kron3(scalar_A, B);
+  for (const bool blocked : {true, false}) {
+    const SparseMatrixd& A = blocked ? blocked_A : scalar_A;
+    const std::vector<SparseMatrixd>& P = blocked ? blocked_P : scalar_P;
+    for (const int degree : {1, 2, 3}) {
+      SCOPED_TRACE(std::string(blocked ? "blocked" : "scalar") + ", degree " +
+                   std::to_string(degree));
+      MultigridOptions options;
+      options.smoothing_degree = degree;
+      MultigridPreconditioner mg(P, options);
+      ASSERT_TRUE(mg.setup(A));
+      for (int k = 1; k < mg.num_levels(); ++k)
+        EXPECT_EQ(mg.blocked_products(k), blocked) << "level " << k;
+      const ReferenceCycle reference(A, P, mg, degree);
+      const VectorXd r = VectorXd::Random(A.rows());
+      VectorXd z;
+      mg.apply(r, z);
+      const VectorXd expected = reference.apply(r);
+      EXPECT_LE((z - expected).norm(), 1e-10 * expected.norm());
+    }
+  }
+}
+
 TEST(Multigrid, CycleDoesNotDependOnTheThreadCount) {
-  // Levels large enough for many chunks, with a blocked finest operator and scalar coarse ones.
+  // Levels large enough for many chunks, blocked (fused products) and scalar.
   std::mt19937 random(17u);
-  const std::vector<SparseMatrixd> prolongations = {random_prolongation(4000, 800, random),
-                                                    random_prolongation(30000, 4000, random)};
-  const SparseMatrixd A = random_spd(30000, 6, random);
-  MultigridPreconditioner mg(prolongations);
-  ASSERT_TRUE(mg.setup(A));
-  const VectorXd r = VectorXd::Random(A.rows());
-  VectorXd one, two;
-  set_thread_policy({.threads = 1});
-  mg.apply(r, one);
-  set_thread_policy({.threads = 2});
-  mg.apply(r, two);
-  set_thread_policy({});
-  EXPECT_EQ(one, two);
-  EXPECT_GT(r.dot(one), 0.0);
+  Eigen::Matrix3d B;
+  B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;
+  const std::vector<SparseMatrixd> scalar_P = {random_prolongation(1400, 300, random),
+                                               random_prolongation(10000, 1400, random)};
+  const SparseMatrixd scalar_A = random_spd(10000, 6, random);
+  const std::vector<SparseMatrixd> blocked_P = {kron3(scalar_P[0], Eigen::Matrix3d::Identity()),
+                                                kron3(scalar_P[1], Eigen::Matrix3d::Identity())};
+  const SparseMatrixd blocked_A = kron3(scalar_A, B);
+  for (const bool blocked : {true, false}) {
+    const SparseMatrixd& A = blocked ? blocked_A : scalar_A;
+    MultigridPreconditioner mg(blocked ? blocked_P : scalar_P);
+    ASSERT_TRUE(mg.setup(A));
+    EXPECT_EQ(mg.blocked_products(mg.num_levels() - 1), blocked);
+    const VectorXd r = VectorXd::Random(A.rows());
+    VectorXd one, two;
+    set_thread_policy({.threads = 1});
+    mg.apply(r, one);
+    set_thread_policy({.threads = 2});
+    mg.apply(r, two);
+    set_thread_policy({});
+    EXPECT_EQ(one, two) << (blocked ? "blocked" : "scalar");
+    EXPECT_GT(r.dot(one), 0.0);
+  }
 }
 
 }  // namespace

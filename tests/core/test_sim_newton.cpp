@@ -125,8 +125,9 @@ TEST(Newton, UnreachableResidualConvergesOnTheIncrement) {
 
 TEST(Newton, AKeptWorkspaceGivesTheSameSolvesAsFreshMatrices) {
   // Two load steps minimised with one workspace kept between the calls, against the same calls
-  // with matrices of their own: the same iterates to the bit. A workspace filled for another
-  // energy (another size) is started afresh.
+  // with matrices of their own: the same iterates to the bit. A workspace left by another energy
+  // is started afresh: here its matrices have this energy's sizes and column starts but other
+  // rows, which, reused as they are, would put the Hessians in the wrong entries.
   const Cantilever c;
   EnergySum energy(c.embedded->stiffness_pattern());
   energy.emplace<ElasticTerm>(*c.embedded);

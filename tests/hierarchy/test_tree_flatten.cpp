@@ -59,9 +59,11 @@ TEST(TreeFlatten, MapsLeadBackToTheTree) {
   const FlatTreeMesh flat = flatten_leaves(tree);
   ASSERT_EQ(flat.mesh.tets.rows(), tree.num_leaves());
   ASSERT_EQ(flat.tet_nodes.size(), static_cast<std::size_t>(tree.num_leaves()));
+  ASSERT_EQ(flat.tet_levels.size(), flat.tet_nodes.size());
   ASSERT_EQ(flat.tree_vertices.size(), static_cast<std::size_t>(flat.mesh.vertices.rows()));
   ASSERT_EQ(flat.mesh_vertices.size(), static_cast<std::size_t>(tree.vertex_capacity()));
   for (Index t = 0; t < flat.mesh.tets.rows(); ++t) {
+    EXPECT_EQ(flat.tet_levels[t], tree.level(flat.tet_nodes[t]));
     const std::array<int, 4> v = tree.tet_vertices(flat.tet_nodes[t]);
     for (int i = 0; i < 4; ++i) {
       EXPECT_EQ(flat.tree_vertices[flat.mesh.tets(t, i)], v[i]);

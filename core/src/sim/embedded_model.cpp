@@ -213,7 +213,10 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
   double* values = K.valuePtr();
   for_each_vector_chunk(
       K.nonZeros(), [&](Index begin, Index end) { std::fill(values + begin, values + end, 0.0); });
-  m_layer_values.assign(3 * m_block_targets.size(), 0.0);
+  m_layer_values.resize(3 * m_block_targets.size());
+  for_each_vector_chunk(static_cast<Index>(m_layer_values.size()), [&](Index begin, Index end) {
+    std::fill(m_layer_values.data() + begin, m_layer_values.data() + end, 0.0);
+  });
   m_model->stiffness_into(expand(q), project_psd,
                           {values, m_offsets.data(), m_in_layer.data(), m_layer_values.data()});
   // The layer's blocks into their targets, in the order of the serial pass. Each thread takes

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "strata/core/common/error.hpp"
 #include "strata/core/common/vector_chunks.hpp"
 #include "strata/core/sim/block_matrix.hpp"
 
@@ -370,6 +371,15 @@ void MultigridPreconditioner::setup_smoother(Level& level) {
   level.lambda_min = m_options.chebyshev_lower * lambda;
 }
 
+std::pair<double, double> MultigridPreconditioner::smoother_interval(int k) const {
+  const Level& level = *m_levels.at(static_cast<std::size_t>(k));
+  return {level.lambda_min, level.lambda_max};
+}
+
+bool MultigridPreconditioner::blocked_products(int k) const {
+  return !m_levels.at(static_cast<std::size_t>(k))->blocks.empty();
+}
+
 void MultigridPreconditioner::widen_smoother_intervals() {
   for (int k = 1; k < num_levels(); ++k) {  // level 0 is solved directly
     Level& level = *m_levels[k];
@@ -397,7 +407,10 @@ void MultigridPreconditioner::smooth(const Level& level, const VectorXd& b, Vect
   r.resize(n);
   d.resize(n);
   d_next.resize(n);
-  x.resize(n);
+  if (zero_start)
+    x.resize(n);
+  else
+    STRATA_VERIFY(x.size() == n, "MultigridPreconditioner::smooth: x has the wrong size");
   // The first direction d = D r / θ (x, when not zero, is read by its product and takes d with
   // the next update).
   const auto first_direction = [&](Index begin, Index end) {

@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "strata/core/common/fill_vector.hpp"
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/material.hpp"
 #include "strata/core/fem/tet_partition.hpp"
@@ -113,10 +114,10 @@ class ElasticModel {
   VectorXd m_rest_positions;
   /// Parallel schedule; the arrays below are in its sorted tet order.
   TetPartition m_partition;
-  std::vector<int> m_sorted_tets;           ///< 4 per tet
-  std::vector<double> m_sorted_Dm_inv;      ///< 9 per tet, column-major
-  std::vector<double> m_sorted_volume;      ///< 1 per tet
-  std::vector<double> m_sorted_Dm_inv_det;  ///< det Dm⁻¹, 1 per tet
+  std::vector<int> m_sorted_tets;          ///< 4 per tet
+  FillVector<double> m_sorted_Dm_inv;      ///< 9 per tet, column-major
+  FillVector<double> m_sorted_volume;      ///< 1 per tet
+  FillVector<double> m_sorted_Dm_inv_det;  ///< det Dm⁻¹, 1 per tet
   /// Dm⁻¹ and rest volume in lane groups for the vectorised kernels, kLaneRest per group.
   static constexpr int kLaneRest = 40;
   std::vector<double> m_lane_rest;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "strata/core/common/fill_vector.hpp"
 #include "strata/core/common/types.hpp"
 
 namespace strata {
@@ -37,9 +38,9 @@ class BlockSymmetricMatrix {
 
  private:
   Index m_num_blocks = 0;
-  std::vector<int> m_outer;       ///< block column b: blocks m_outer[b] .. m_outer[b + 1]
-  std::vector<int> m_block_rows;  ///< block row a of each block
-  std::vector<double> m_values;   ///< 9 per block: entry (i, j) at 3j + i
+  std::vector<int> m_outer;      ///< block column b: blocks m_outer[b] .. m_outer[b + 1]
+  FillVector<int> m_block_rows;  ///< block row a of each block
+  FillVector<double> m_values;   ///< 9 per block: entry (i, j) at 3j + i
 };
 
 }  // namespace strata

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "strata/core/common/fill_vector.hpp"
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/elastic_model.hpp"
 
@@ -98,13 +99,13 @@ class EmbeddedElasticModel {
   /// For each tet in the mesh model's order (ElasticModel::sorted_tets): whether it is in the
   /// layer, and the 48 offsets of its element blocks in K_q's values or in the layer's.
   std::vector<std::uint8_t> m_in_layer;
-  std::vector<int> m_offsets;
+  FillVector<int> m_offsets;
   Index m_num_layer_tets = 0;
   /// Per 3-value column of a layer block (values 3g … 3g + 2), in order: the reduced value it adds
   /// to with weight 1 (≥ 0), or ~n (< 0): it goes to the next n entries of m_weighted_targets.
-  std::vector<int> m_block_targets;
-  std::vector<WeightedTarget> m_weighted_targets;
-  mutable std::vector<double> m_layer_values;  ///< the layer's mesh-level blocks
+  FillVector<int> m_block_targets;
+  FillVector<WeightedTarget> m_weighted_targets;
+  mutable FillVector<double> m_layer_values;  ///< the layer's mesh-level blocks
 };
 
 }  // namespace strata

@@ -23,6 +23,7 @@
 /// up anew. Matrix–vector products and the smoothers run on TBB threads.
 #include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -106,6 +107,10 @@ class MultigridPreconditioner {
   void widen_smoother_intervals();
 
   int num_levels() const { return static_cast<int>(m_levels.size()); }
+  /// The Chebyshev interval [λ_min, λ_max] of level k's smoother (D⁻¹A; k ≥ 1) and whether its
+  /// products use the 3 × 3-block copy, as of the last setup (for tests and diagnostics).
+  std::pair<double, double> smoother_interval(int k) const;
+  bool blocked_products(int k) const;
   /// Unknowns per level, coarsest first.
   std::vector<Index> level_sizes() const;
   double setup_seconds() const { return m_setup_seconds; }  ///< wall time of the last setup()
