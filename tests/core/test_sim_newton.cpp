@@ -155,6 +155,7 @@ TEST(Newton, AKeptWorkspaceGivesTheSameSolvesAsFreshMatrices) {
   workspace.hessian = shuffled(c.embedded->stiffness_pattern());
   workspace.reduced_hessian = shuffled(reduced_pattern);
   workspace.energy = &other;
+  workspace.pattern = &c.embedded->stiffness_pattern();
   workspace.reduction = &reduction;
 
   SpdSolver kept_solver(LinearSolverKind::cholmod), fresh_solver(LinearSolverKind::cholmod);
@@ -168,6 +169,7 @@ TEST(Newton, AKeptWorkspaceGivesTheSameSolvesAsFreshMatrices) {
     EXPECT_EQ(with_workspace.residuals, without.residuals) << "load " << load;
     EXPECT_EQ(kept, fresh) << "load " << load;
     EXPECT_EQ(workspace.energy, &energy);
+    EXPECT_EQ(workspace.pattern, &energy.pattern());
     EXPECT_EQ(workspace.reduced_hessian.rows(), reduction.num_free());
   }
 }

@@ -108,9 +108,11 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
   VectorXd gradient(x.size()), trial_gradient(x.size());
   NewtonWorkspace local;
   NewtonWorkspace& kept = workspace != nullptr ? *workspace : local;
-  if (kept.energy != &objective || kept.reduction != &reduction) {
+  if (kept.energy != &objective || kept.pattern != &objective.pattern() ||
+      kept.reduction != &reduction) {
     kept = NewtonWorkspace();
     kept.energy = &objective;
+    kept.pattern = &objective.pattern();
     kept.reduction = &reduction;
   }
   SparseMatrixd& hessian = kept.hessian;

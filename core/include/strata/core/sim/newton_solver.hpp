@@ -89,8 +89,10 @@ double internal_force_roundoff(const EmbeddedElasticModel& model);
 struct NewtonWorkspace {
   SparseMatrixd hessian;          ///< of the energy, all DOFs
   SparseMatrixd reduced_hessian;  ///< restricted to the free DOFs
-  /// The energy and reduction the matrices were filled for; a call with others starts afresh.
+  /// The energy, its Hessian pattern and the reduction the matrices were filled for; a call
+  /// with any other starts afresh.
   const void* energy = nullptr;
+  const void* pattern = nullptr;
   const void* reduction = nullptr;
 };
 
