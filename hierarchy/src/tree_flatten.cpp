@@ -44,16 +44,15 @@ FlatTreeMesh flatten_nodes(const TetTree& tree, const std::vector<NodeId>& nodes
   const Index num_tets = static_cast<Index>(nodes.size());
   flat.mesh.tets.resize(num_tets, 4);
   flat.tet_levels.resize(nodes.size());
-  tbb::parallel_for(
-      tbb::blocked_range<Index>(0, num_tets, kChunk), [&](const tbb::blocked_range<Index>& r) {
-        for (Index t = r.begin(); t < r.end(); ++t) {
-          const TetNode& record = tree.node(nodes[t]);
-          const std::array<int, 4> vertices = oriented_tet(record.vertices, record.orientation);
-          for (int i = 0; i < 4; ++i)
-            flat.mesh.tets(t, i) = flat.mesh_vertices[vertices[i]];
-          flat.tet_levels[t] = record.level;
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<Index>(0, num_tets, kChunk),
+                    [&](const tbb::blocked_range<Index>& r) {
+                      for (Index t = r.begin(); t < r.end(); ++t) {
+                        const std::array<int, 4> vertices = tree.tet_vertices(nodes[t]);
+                        for (int i = 0; i < 4; ++i)
+                          flat.mesh.tets(t, i) = flat.mesh_vertices[vertices[i]];
+                        flat.tet_levels[t] = static_cast<std::int8_t>(tree.level(nodes[t]));
+                      }
+                    });
   return flat;
 }
 

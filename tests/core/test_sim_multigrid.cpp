@@ -290,22 +290,34 @@ class ReferenceCycle {
   int m_degree;
 };
 
+/// A three-level problem in two forms: scalar (random SPD A, random P, no whole blocks) and
+/// blocked (A ⊗ B and P ⊗ I₃, whole 3 × 3 blocks on every level, the fused block products).
+struct TwoForms {
+  std::vector<SparseMatrixd> scalar_P, blocked_P;
+  SparseMatrixd scalar_A, blocked_A;
+  TwoForms(Index coarse, Index middle, Index fine, std::mt19937& random) {
+    Eigen::Matrix3d B;
+    B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;
+    scalar_P = {random_prolongation(middle, coarse, random),
+                random_prolongation(fine, middle, random)};
+    scalar_A = random_spd(fine, 6, random);
+    for (const SparseMatrixd& P : scalar_P)
+      blocked_P.push_back(kron3(P, Eigen::Matrix3d::Identity()));
+    blocked_A = kron3(scalar_A, B);
+  }
+  const SparseMatrixd& A(bool blocked) const { return blocked ? blocked_A : scalar_A; }
+  const std::vector<SparseMatrixd>& P(bool blocked) const { return blocked ? blocked_P : scalar_P; }
+};
+
 TEST(Multigrid, CycleIsTheTextbookVCycle) {
   // Against the serial reference above, for smoothing degrees 1–3, on blocked operators (the
   // fused block products, every level) and on scalar ones (the compressed-column products),
   // with levels large enough for several chunks.
   std::mt19937 random(19u);
-  Eigen::Matrix3d B;
-  B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;
-  const std::vector<SparseMatrixd> scalar_P = {random_prolongation(300, 60, random),
-                                               random_prolongation(2400, 300, random)};
-  const SparseMatrixd scalar_A = random_spd(2400, 6, random);
-  const std::vector<SparseMatrixd> blocked_P = {kron3(scalar_P[0], Eigen::Matrix3d::Identity()),
-                                                kron3(scalar_P[1], Eigen::Matrix3d::Identity())};
-  const SparseMatrixd blocked_A = kron3(scalar_A, B);
+  const TwoForms problem(60, 300, 2400, random);
   for (const bool blocked : {true, false}) {
-    const SparseMatrixd& A = blocked ? blocked_A : scalar_A;
-    const std::vector<SparseMatrixd>& P = blocked ? blocked_P : scalar_P;
+    const SparseMatrixd& A = problem.A(blocked);
+    const std::vector<SparseMatrixd>& P = problem.P(blocked);
     for (const int degree : {1, 2, 3}) {
       SCOPED_TRACE(std::string(blocked ? "blocked" : "scalar") + ", degree " +
                    std::to_string(degree));
@@ -328,17 +340,10 @@ TEST(Multigrid, CycleIsTheTextbookVCycle) {
 TEST(Multigrid, CycleDoesNotDependOnTheThreadCount) {
   // Levels large enough for many chunks, blocked (fused products) and scalar.
   std::mt19937 random(17u);
-  Eigen::Matrix3d B;
-  B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;
-  const std::vector<SparseMatrixd> scalar_P = {random_prolongation(1400, 300, random),
-                                               random_prolongation(10000, 1400, random)};
-  const SparseMatrixd scalar_A = random_spd(10000, 6, random);
-  const std::vector<SparseMatrixd> blocked_P = {kron3(scalar_P[0], Eigen::Matrix3d::Identity()),
-                                                kron3(scalar_P[1], Eigen::Matrix3d::Identity())};
-  const SparseMatrixd blocked_A = kron3(scalar_A, B);
+  const TwoForms problem(300, 1400, 10000, random);
   for (const bool blocked : {true, false}) {
-    const SparseMatrixd& A = blocked ? blocked_A : scalar_A;
-    MultigridPreconditioner mg(blocked ? blocked_P : scalar_P);
+    const SparseMatrixd& A = problem.A(blocked);
+    MultigridPreconditioner mg(problem.P(blocked));
     ASSERT_TRUE(mg.setup(A));
     EXPECT_EQ(mg.blocked_products(mg.num_levels() - 1), blocked);
     const VectorXd r = VectorXd::Random(A.rows());

@@ -91,8 +91,7 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
   double multiply(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
                   const std::function<double(Index, Index)>& after) const override {
     if (cycle != nullptr) return cycle->multiply_finest(A, x, y, after);
-    symmetric_product(A, x, y);
-    return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
+    return symmetric_product(A, x, y, after);
   }
   double setup_seconds() const override { return seconds; }
   int num_levels() const override { return cycle != nullptr ? cycle->num_levels() : 0; }

@@ -138,6 +138,12 @@ void symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y
   });
 }
 
+double symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+                         const std::function<double(Index, Index)>& after) {
+  symmetric_product(A, x, y);
+  return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
+}
+
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
   const Index m = P.cols();
   const SparseMatrixd PT = P.transpose();  // column i of PT = row i of P
@@ -496,8 +502,7 @@ void MultigridPreconditioner::cycle(int k, const VectorXd& b, VectorXd& x) const
 double MultigridPreconditioner::multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y,
                                          const std::function<double(Index, Index)>& after) {
   if (!level.blocks.empty()) return level.blocks.multiply(x, y, after);
-  symmetric_product(*level.A, x, y);
-  return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
+  return symmetric_product(*level.A, x, y, after);
 }
 
 void MultigridPreconditioner::multiply_finest(const SparseMatrixd& A, ConstRef<VectorXd> x,
@@ -510,8 +515,7 @@ double MultigridPreconditioner::multiply_finest(
     const std::function<double(Index, Index)>& after) const {
   const Level& finest = *m_levels.back();
   if (&A == finest.A) return multiply(finest, x, y, after);
-  symmetric_product(A, x, y);
-  return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
+  return symmetric_product(A, x, y, after);
 }
 
 void MultigridPreconditioner::apply(ConstRef<VectorXd> r, VectorXd& z) const {

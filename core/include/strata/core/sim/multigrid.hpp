@@ -55,6 +55,10 @@ std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
 
 /// y = A x for a symmetric A stored with both triangles (column-major), in parallel over columns.
 void symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y);
+/// The same, then `after(begin, end)` on y's rows by the chunks of vector_chunks.hpp (in
+/// parallel); returns the sum of its values in chunk order (0 for an empty `after`).
+double symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
+                         const std::function<double(Index, Index)>& after);
 
 struct MultigridOptions {
   int smoothing_degree = 3;     ///< Chebyshev degree of the pre- and post-smoother
