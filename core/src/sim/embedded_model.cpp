@@ -213,36 +213,105 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
   double* values = K.valuePtr();
   for_each_vector_chunk(
       K.nonZeros(), [&](Index begin, Index end) { std::fill(values + begin, values + end, 0.0); });
-  m_layer_values.resize(3 * m_block_targets.size());
+  m_layer_values.resize(3 * m_num_layer_blocks);
   for_each_vector_chunk(static_cast<Index>(m_layer_values.size()), [&](Index begin, Index end) {
     std::fill(m_layer_values.data() + begin, m_layer_values.data() + end, 0.0);
   });
   m_model->stiffness_into(expand(q), project_psd,
                           {values, m_offsets.data(), m_in_layer.data(), m_layer_values.data()});
-  // The layer's blocks into their targets, in the order of the serial pass. Each thread takes
-  // the targets in its own range of K's values and walks the whole layer for them: every value
-  // receives its additions in the same order at any thread count.
-  const int num_ranges = std::max(1, std::min(max_threads(), 8));
-  const Index nonzeros = K.nonZeros();
-  tbb::parallel_for(0, num_ranges, [&](int range) {
-    const Index first = nonzeros * range / num_ranges;
-    const Index last = nonzeros * (range + 1) / num_ranges;
-    const auto mine = [&](int target) { return target >= first && target < last; };
-    const double* source = m_layer_values.data();
-    const WeightedTarget* weighted = m_weighted_targets.data();
-    for (const int target : m_block_targets) {
-      if (target >= 0) {
-        if (mine(target))
-          for (int i = 0; i < 3; ++i)
-            values[target + i] += source[i];
-      } else {
-        for (int n = 0; n < ~target; ++n, ++weighted)
-          if (mine(weighted->target))
-            for (int i = 0; i < 3; ++i)
-              values[weighted->target + i] += weighted->weight * source[i];
-      }
-      source += 3;
+  // The layer's blocks into their targets, range by range of K's values (each range's additions
+  // in the order of the serial pass).
+  const double* source = m_layer_values.data();
+  const LayerAddition* additions = m_layer_additions.data();
+  tbb::parallel_for(Index(0), static_cast<Index>(m_range_begin.size()) - 1, [&](Index range) {
+    for (Index k = m_range_begin[range]; k < m_range_begin[range + 1]; ++k) {
+      const LayerAddition& addition = additions[k];
+      const double* block = source + 3 * Index(addition.block);
+      for (int i = 0; i < 3; ++i)
+        values[addition.target + i] += addition.weight * block[i];
     }
+  });
+}
+
+void EmbeddedElasticModel::group_layer_additions(const FillVector<int>& block_targets,
+                                                 const FillVector<WeightedTarget>& weighted) {
+  const auto num_blocks = static_cast<Index>(block_targets.size());
+  m_num_layer_blocks = num_blocks;
+  // Fixed chunks of blocks (the additions of chunk c come before those of chunk c + 1 in every
+  // range) and slices of K_q's values 2^shift long (at most 2 · kTargetBins of them); a range is a
+  // run of slices.
+  constexpr Index kTargetBins = 512;
+  constexpr Index kRanges = 16;
+  int shift = 0;
+  while ((m_pattern.nonZeros() >> shift) >= kTargetBins)
+    ++shift;
+  const Index num_bins = (m_pattern.nonZeros() >> shift) + 1;
+  const Index num_chunks = std::clamp<Index>(num_blocks / 2048, 1, 128);
+  const auto chunk_begin = [&](Index c) { return num_blocks * c / num_chunks; };
+  const auto bin_of = [shift](int target) { return static_cast<Index>(target >> shift); };
+  // The first weighted entry of each chunk.
+  std::vector<Index> first_weighted(num_chunks + 1, 0);
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    Index count = 0;
+    for (Index g = chunk_begin(c); g < chunk_begin(c + 1); ++g)
+      if (block_targets[g] < 0) count += ~block_targets[g];
+    first_weighted[c + 1] = count;
+  });
+  for (Index c = 0; c < num_chunks; ++c)
+    first_weighted[c + 1] += first_weighted[c];
+  // Visits the additions of chunk c in serial order: visit(block, target, weight).
+  const auto for_each_addition = [&](Index c, auto&& visit) {
+    const WeightedTarget* next = weighted.data() + first_weighted[c];
+    for (Index g = chunk_begin(c); g < chunk_begin(c + 1); ++g) {
+      const int target = block_targets[g];
+      if (target >= 0) {
+        visit(g, target, 1.0);
+        continue;
+      }
+      for (int n = 0; n < ~target; ++n, ++next)
+        visit(g, next->target, next->weight);
+    }
+  };
+  std::vector<Index> counts(num_chunks * num_bins, 0);  // additions per chunk and slice
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    Index* chunk_counts = &counts[c * num_bins];
+    for_each_addition(c, [&](Index, int target, double) { ++chunk_counts[bin_of(target)]; });
+  });
+  std::vector<Index> bin_total(num_bins, 0);
+  for (Index c = 0; c < num_chunks; ++c)
+    for (Index b = 0; b < num_bins; ++b)
+      bin_total[b] += counts[c * num_bins + b];
+  Index total = 0;
+  for (const Index n : bin_total)
+    total += n;
+  // Slices to ranges: range r ends at the first slice where the additions so far reach
+  // total · (r + 1) / kRanges.
+  std::vector<Index> range_of_bin(num_bins);
+  for (Index b = 0, range = 0, so_far = 0; b < num_bins; ++b) {
+    range_of_bin[b] = range;
+    so_far += bin_total[b];
+    while (range + 1 < kRanges && so_far * kRanges >= total * (range + 1))
+      ++range;
+  }
+  // Where each chunk's additions of each range go: ranges in order, chunks in order within one.
+  std::vector<Index> position(kRanges * num_chunks, 0);
+  for (Index c = 0; c < num_chunks; ++c)
+    for (Index b = 0; b < num_bins; ++b)
+      position[range_of_bin[b] * num_chunks + c] += counts[c * num_bins + b];
+  m_range_begin.assign(kRanges + 1, 0);
+  for (Index k = 0, start = 0; k < kRanges * num_chunks; ++k) {
+    if (k % num_chunks == 0) m_range_begin[k / num_chunks] = start;
+    const Index n = position[k];
+    position[k] = start;
+    start += n;
+  }
+  m_range_begin[kRanges] = total;
+  m_layer_additions.resize(total);
+  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
+    for_each_addition(c, [&](Index g, int target, double weight) {
+      Index& at = position[range_of_bin[bin_of(target)] * num_chunks + c];
+      m_layer_additions[at++] = {static_cast<int>(g), target, weight};
+    });
   });
 }
 
@@ -367,8 +436,8 @@ void EmbeddedElasticModel::build_reduced_pattern() {
     first_weighted[w + 1] += first_weighted[w];
   if (first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
-  m_block_targets.resize(3 * layer.indices.size());
-  m_weighted_targets.resize(first_weighted[num_mesh_vertices]);
+  FillVector<int> block_targets(3 * layer.indices.size());
+  FillVector<WeightedTarget> weighted_targets(first_weighted[num_mesh_vertices]);
   // Per thread: the slot of each DOF vertex in the lists of `blocks` of w's row entries (up to
   // kMarked of them; −1 elsewhere), and the slots of one vertex's targets.
   constexpr int kMarked = 4;
@@ -419,20 +488,21 @@ void EmbeddedElasticModel::build_reduced_pattern() {
         const int v = list[k];
         const Index block = block_column_start(layer, w, j) / 3 + static_cast<Index>(k);
         if (direct_dof[v] >= 0 && direct_dof[w] >= 0) {
-          m_block_targets[block] =
+          block_targets[block] =
               static_cast<int>(block_column_start(blocks, direct_dof[w], j) + 3 * *next_slot++);
           continue;
         }
         const Index first = position;
         for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
           for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
-            m_weighted_targets[position++] = {
+            weighted_targets[position++] = {
                 static_cast<int>(block_column_start(blocks, row_inner[ib], j) + 3 * *next_slot++),
                 row_values[ia] * row_values[ib]};
-        m_block_targets[block] = ~static_cast<int>(position - first);
+        block_targets[block] = ~static_cast<int>(position - first);
       }
     }
   });
+  group_layer_additions(block_targets, weighted_targets);
 }
 
 }  // namespace strata

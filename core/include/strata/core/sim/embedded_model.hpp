@@ -15,8 +15,10 @@
 /// vertices are DOF vertices (C rows e_q) adds its element stiffness straight to K_q in the mesh
 /// model's parallel pass; the tets that touch a hanging vertex (a thin layer where levels meet)
 /// assemble a mesh-level matrix of their own vertex blocks, each of whose blocks (v, w) then adds
-/// to the reduced blocks (a, b) with weight C_va C_wb in one serial pass. The result does not
-/// depend on the thread count.
+/// to the reduced blocks (a, b) with weight C_va C_wb. Those additions are grouped once per
+/// embedding into ranges of K_q's values, each range's in the order of the serial pass over the
+/// layer, and the ranges add in parallel: every value receives its additions in the serial order,
+/// so the result does not depend on the thread count.
 ///
 /// Requirements on C (checked, InputError): every row sums to 1 with non-negative entries
 /// (partition of unity: affine fields and rigid motions are reproduced exactly) and each DOF
@@ -84,7 +86,18 @@ class EmbeddedElasticModel {
     int target;
     double weight;
   };
+  /// One addition of the layer's scatter: K_q's values[target + i] += weight · layer value
+  /// 3 · block + i, i = 0, 1, 2 (weight 1 for a block of two DOF vertices).
+  struct LayerAddition {
+    int block;
+    int target;
+    double weight;
+  };
   void build_reduced_pattern();
+  /// m_layer_additions and m_range_begin from the layer blocks' targets (block_targets as
+  /// described at m_layer_additions, weighted the entries they point to).
+  void group_layer_additions(const FillVector<int>& block_targets,
+                             const FillVector<WeightedTarget>& weighted);
 
   const ElasticModel* m_model;
   bool m_identity = true;
@@ -101,10 +114,13 @@ class EmbeddedElasticModel {
   std::vector<std::uint8_t> m_in_layer;
   FillVector<int> m_offsets;
   Index m_num_layer_tets = 0;
-  /// Per 3-value column of a layer block (values 3g … 3g + 2), in order: the reduced value it adds
-  /// to with weight 1 (≥ 0), or ~n (< 0): it goes to the next n entries of m_weighted_targets.
-  FillVector<int> m_block_targets;
-  FillVector<WeightedTarget> m_weighted_targets;
+  /// The additions of the layer's blocks (3-value columns, values 3g … 3g + 2 of block g) to
+  /// K_q, grouped by consecutive ranges of K_q's values (with about equal numbers of additions):
+  /// range r's are [m_range_begin[r], m_range_begin[r + 1]) of m_layer_additions, in the order of
+  /// the serial pass (blocks ascending, each block's targets in the order C_va, C_wb).
+  FillVector<LayerAddition> m_layer_additions;
+  std::vector<Index> m_range_begin{0};
+  Index m_num_layer_blocks = 0;
   mutable FillVector<double> m_layer_values;  ///< the layer's mesh-level blocks
 };
 
