@@ -153,6 +153,11 @@ AdaptiveSimulation::AdaptiveSimulation(
   for (const RootPoint& point : m_contact_surface)
     if (point.root < 0 || point.root >= m_tree->num_roots() || !point.position.allFinite())
       throw InputError("contact surface: a point needs a root tet and a finite position");
+  if (!m_obstacles.empty() && m_contact_surface.empty() && m_settings.finest_contact_points &&
+      m_settings.mode != HierarchyMode::full && m_settings.levels > 0) {
+    m_contact_surface = finest_boundary_points(*m_tree);
+    m_finest_contact = true;
+  }
   const int start_level =
       m_settings.mode == HierarchyMode::full ? m_settings.levels : m_settings.level;
   if (m_settings.mode == HierarchyMode::precomputed) {
@@ -508,6 +513,7 @@ void AdaptiveSimulation::add_contact(SimulationOptions& options) const {
   if (m_obstacles.empty()) return;
   options.obstacles = m_obstacles;
   options.contact_stiffness = m_contact_stiffness;
+  options.boundary_contact_points = !m_finest_contact;
   options.contact_points.clear();
   options.contact_points.reserve(m_contact_surface.size());
   for (const CutPointWeights& w : embed_points(*m_cut, m_constrained->flat, m_contact_surface))

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 #include <unordered_map>
@@ -60,10 +61,11 @@ void for_each_lattice_point(int m, Visit&& visit) {
       }
 }
 
-/// A coarse boundary triangle and the root tet it bounds.
+/// A coarse boundary triangle and the root tet it bounds (its corners' tree vertices, ascending).
 struct BoundaryTriangle {
   NodeId root;
   Vector3d corner[3];
+  std::array<int, 3> vertex{-1, -1, -1};
 };
 
 std::vector<BoundaryTriangle> coarse_boundary(const TetTree& tree) {
@@ -81,7 +83,7 @@ std::vector<BoundaryTriangle> coarse_boundary(const TetTree& tree) {
   std::vector<BoundaryTriangle> boundary;
   for (const auto& [key, use] : faces)
     if (use.first == 1) {
-      BoundaryTriangle triangle{use.second, {}};
+      BoundaryTriangle triangle{use.second, {}, key};
       for (int c = 0; c < 3; ++c)
         triangle.corner[c] = tree.vertex_position(key[c]);
       boundary.push_back(triangle);
@@ -171,6 +173,34 @@ std::vector<CutPointWeights> embed_points(const ActiveCut& cut, const FlatTreeMe
   for (const RootPoint& point : points)
     result.push_back(embed_point(cut, flat, point));
   return result;
+}
+
+std::vector<RootPoint> finest_boundary_points(const TetTree& tree) {
+  // On a coarse boundary triangle (a, b, c) the finest level's vertices are the points
+  // (k a + i b + j c) / n, i + j + k = n = 2^L (midpoint splits, L times). A point on an edge or
+  // corner shared by two triangles has the same non-zero weights on the same tree vertices in
+  // both: that list is its key.
+  const int n = 1 << tree.max_level();
+  std::vector<RootPoint> points;
+  std::set<std::array<int, 6>> seen;
+  for (const BoundaryTriangle& face : coarse_boundary(tree))
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const int weight[3] = {n - i - j, i, j};
+        std::array<int, 6> key{-1, 0, -1, 0, -1, 0};  // (vertex, weight) × 3, vertices ascending
+        for (int c = 0, used = 0; c < 3; ++c)
+          if (weight[c] > 0) {
+            key[2 * used] = face.vertex[c];
+            key[2 * used + 1] = weight[c];
+            ++used;
+          }
+        if (!seen.insert(key).second) continue;
+        const Vector3d position =
+            (weight[0] * face.corner[0] + weight[1] * face.corner[1] + weight[2] * face.corner[2]) /
+            static_cast<double>(n);
+        points.push_back({face.root, position});
+      }
+  return points;
 }
 
 std::vector<PointLoad> finest_level_loads(const TetTree& tree, const std::vector<RegionLoad>& loads,

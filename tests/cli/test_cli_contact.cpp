@@ -174,6 +174,61 @@ TEST(CliContact, AdaptiveDropOnASphereFollowsFullResolution) {
   EXPECT_LT(difference, 0.02 * largest);
 }
 
+TEST(CliContact, AnIndentingSphereBetweenTheCoarseVerticesIsFeltOnTheHierarchy) {
+  // A block pressed by its top face onto a rigid sphere whose top lies between the vertices of
+  // the coarse mesh (3.2 mm below the nearest one), static, 2 levels, with nothing but `levels`
+  // set in `hierarchy`. The finest level's boundary vertices are the contact points of every cut,
+  // so the first load step already presses on the sphere, the cut refines (on this small block
+  // past full_resolution_fraction, to full resolution) and the probe on the contact point
+  // follows full resolution within the tolerance. With the coarse cut's
+  // boundary vertices alone (`finest_contact_points` false) the first load step misses the
+  // sphere, the body moves rigidly (an estimate of 0) and the probe is far off.
+  TempFolder folder;
+  const auto write_scene = [&](const std::string& name, const json& hierarchy) {
+    json scene = json::parse(R"({
+      "mesh": {"box": {"min": [0, 0, 0], "max": [0.3, 0.3, 0.1], "cells": [3, 3, 1]}},
+      "material": {"model": "neohookean", "youngs_modulus": 3e5, "poisson_ratio": 0.4,
+                   "density": 1000},
+      "obstacles": [{"implicit": {"sphere": {"center": [0.12, 0.17, -0.2], "radius": 0.2}},
+                     "voxel_size": 0.004}],
+      "prescribed": [{"region": {"plane": {"point": [0, 0, 0.1], "normal": [0, 0, 1]}},
+                      "displacement": [0, 0, -0.008]}],
+      "solver": {"mode": "static", "load_steps": 4},
+      "output": {"every": 1, "vtk": false, "probes": [[0.12, 0.17, 0.0], [0.15, 0.15, 0.05]]}
+    })");
+    scene["hierarchy"] = hierarchy;
+    write_text(folder.path() / (name + ".json"), scene.dump(2));
+    const CliResult result = run_strata("run " + name + ".json --quiet", folder.path());
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return read_json(folder.path() / "out" / name / "stats.json");
+  };
+  const json full = write_scene("full", {{"levels", 2}, {"mode", "full"}});
+  const json finest = write_scene("finest", {{"levels", 2}});
+  const json vertices = write_scene("vertices", {{"levels", 2}, {"finest_contact_points", false}});
+  EXPECT_FALSE(full["contact"]["finest_boundary_points"].get<bool>());
+  EXPECT_TRUE(finest["contact"]["finest_boundary_points"].get<bool>());
+  EXPECT_FALSE(vertices["contact"]["finest_boundary_points"].get<bool>());
+  // 3 × 3 × 1 cells: 2 · (9 + 3 + 3) squares, 4 triangles each, 16 finest per triangle.
+  EXPECT_EQ(finest["contact"]["points"].get<int>(), 2 + 16 * 2 * 2 * 15 / 2);
+  EXPECT_GT(finest["contact"]["active_contacts"][0].get<int>(), 0);
+  EXPECT_EQ(vertices["contact"]["active_contacts"][0].get<int>(), 0);
+  const auto probe_error = [&](const std::string& name) {
+    const Csv run = read_csv(folder.path() / "out" / name / "probes.csv");
+    const Csv reference = read_csv(folder.path() / "out" / "full" / "probes.csv");
+    EXPECT_EQ(run.rows.size(), reference.rows.size());
+    double largest = 0.0, difference = 0.0;
+    for (size_t r = 0; r < std::min(run.rows.size(), reference.rows.size()); ++r) {
+      const Vector3d u(run.rows[r][5], run.rows[r][6], run.rows[r][7]);
+      const Vector3d u_full(reference.rows[r][5], reference.rows[r][6], reference.rows[r][7]);
+      largest = std::max(largest, u_full.norm());
+      difference = std::max(difference, (u - u_full).norm());
+    }
+    return difference / largest;
+  };
+  EXPECT_LT(probe_error("finest"), 0.01);
+  EXPECT_GT(probe_error("vertices"), 0.05);
+}
+
 TEST(CliContact, TheArmadilloDroppedOnTheGroundStaysWithinTheTolerance) {
   // The armadillo scan (26,002 vertices) meshed coarsely, on an adaptive cut, dropped 26 mm onto
   // the ground: its fine surface's vertices are contact points through the tree, and none of

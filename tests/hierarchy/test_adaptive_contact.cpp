@@ -101,14 +101,17 @@ TEST(AdaptiveContact, BlockDroppedOnASphereStaysWithinTheToleranceOnAnAdaptiveCu
 }
 
 TEST(AdaptiveContact, AFailedCutChangeLeavesThePreviousCutAtTheStartOfTheStep) {
-  // A block clamped at its top, whose bottom face a sphere pokes through between the corners:
-  // the coarse cut is feasible, but refinement puts the face's centre (a new vertex) inside the
-  // sphere, and the Simulation of the refined cut refuses that rest state. The first step's redo
-  // on the refined cut therefore fails.
+  // A block clamped at its top, whose bottom face a sphere pokes through between the corners,
+  // with only each cut's boundary vertices as contact points: the coarse cut is feasible, but
+  // refinement puts the face's centre (a new vertex) inside the sphere, and the Simulation of the
+  // refined cut refuses that rest state. The first step's redo on the refined cut therefore
+  // fails. (With the finest level's boundary points, the default, the scene is refused at the
+  // start: the face's centre is one of them.)
   const TetMesh coarse =
       box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {1, 1, 1});
   HierarchySettings settings = error_controlled(1, 1e-6);
   settings.initial_adaptation = false;
+  settings.finest_contact_points = false;
   SolverSettings solver;
   solver.dt = 2e-3;
   solver.duration = 0.02;
@@ -132,6 +135,44 @@ TEST(AdaptiveContact, AFailedCutChangeLeavesThePreviousCutAtTheStartOfTheStep) {
   EXPECT_EQ(sim.simulation().positions(), start);
   EXPECT_TRUE(sim.changes().empty());
   EXPECT_THROW(sim.advance(), std::logic_error);
+}
+
+TEST(AdaptiveContact, ASphereBetweenTheCoarseVerticesIsFeltOnACoarseCut) {
+  // A block dropped onto the top of a sphere that meets its bottom face at the face's centre, 3 cm
+  // from the nearest coarse vertex, on the coarse cut of a 2-level tree (uniform level 0, so the
+  // cut stays coarse). With the finest level's boundary points as contact points the face's
+  // centre stops at the sphere; with the coarse cut's boundary vertices alone the sphere passes
+  // between them and pokes into the face.
+  const TetMesh coarse =
+      box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {1, 1, 1});
+  SolverSettings settings;
+  settings.dt = 2e-3;
+  settings.duration = 0.2;
+  Material material = rubber();
+  material.mass_damping = 20.0;
+  const RootPoint centre{0, Vector3d(0, 0, 0.22)};
+  const auto depth_of_centre = [&](bool finest) {
+    HierarchySettings h = hierarchy(2, HierarchyMode::uniform, 0);
+    h.finest_contact_points = finest;
+    AdaptiveSimulation sim(coarse, h, material, {}, {}, std::nullopt, Vector3d(0, 0, -9.81),
+                           settings, {sphere_obstacle(Vector3d::Zero(), 0.2)});
+    TetLocator locator(coarse.vertices, coarse.tets);
+    const std::optional<TetLocation> root = locator.locate(centre.position, 1e-9);
+    EXPECT_TRUE(root.has_value());
+    const RootPoint point{static_cast<NodeId>(root->tet), centre.position};
+    double deepest = 0.0;
+    while (!sim.finished()) {
+      sim.advance();
+      const Vector3d x = point.position + sim.displacements({point}).row(0).transpose();
+      deepest = std::max(deepest, 0.2 - x.norm());
+    }
+    EXPECT_EQ(sim.cut().size(), coarse.tets.rows());
+    return std::pair{deepest, sim.simulation().contact_settings().distance};
+  };
+  const auto [finest_depth, tolerance] = depth_of_centre(true);
+  const auto [vertex_depth, unused] = depth_of_centre(false);
+  EXPECT_LE(finest_depth, tolerance);
+  EXPECT_GT(vertex_depth, 0.005);
 }
 
 TEST(AdaptiveContact, FineContactPointsCarryABlockOnACoarseCut) {

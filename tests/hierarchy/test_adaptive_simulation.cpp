@@ -133,6 +133,44 @@ TEST(FinestLevelLoads, TotalForceIsKeptOnEveryCut) {
                InputError);
 }
 
+TEST(FinestBoundaryPoints, AreTheBoundaryVerticesOfTheFullResolutionMesh) {
+  // A 2 × 1 × 1-cell box, 2 levels: the points are the boundary vertices of the level-2 mesh,
+  // each once, each in (on the boundary of) its root.
+  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 0.5, 0.25), {2, 1, 1});
+  TetTree tree(coarse, 2);
+  const std::vector<RootPoint> points = finest_boundary_points(tree);
+  const TetMesh full = flatten_cut(ActiveCut::uniform(tree, 2)).flat.mesh;
+  std::vector<char> on_boundary(full.vertices.rows(), 0);
+  const MatrixX3i faces = boundary_faces(full.tets);
+  for (Index f = 0; f < faces.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      on_boundary[faces(f, k)] = 1;
+  std::vector<int> matches(points.size(), 0);
+  Index boundary_vertices = 0;
+  for (Index v = 0; v < full.vertices.rows(); ++v) {
+    if (!on_boundary[v]) continue;
+    ++boundary_vertices;
+    int found = 0;
+    for (size_t p = 0; p < points.size(); ++p)
+      if ((points[p].position - full.vertices.row(v).transpose()).norm() < 1e-12) {
+        ++found;
+        ++matches[p];
+      }
+    EXPECT_EQ(found, 1) << "boundary vertex " << v;
+  }
+  EXPECT_EQ(static_cast<Index>(points.size()), boundary_vertices);
+  // A closed surface of F triangles (16 per coarse boundary triangle) has 2 + F / 2 vertices.
+  EXPECT_EQ(static_cast<Index>(points.size()), 2 + 16 * boundary_faces(coarse.tets).rows() / 2);
+  for (size_t p = 0; p < points.size(); ++p) {
+    EXPECT_EQ(matches[p], 1);
+    const Matrix3x4d x = tree.tet_positions(points[p].root);
+    const Eigen::Vector4d lambda =
+        tet_barycentric_coordinates(points[p].position, x.col(0), x.col(1), x.col(2), x.col(3));
+    EXPECT_GE(lambda.minCoeff(), -1e-12);
+    EXPECT_LE(lambda.minCoeff(), 1e-12);  // on a face of the root
+  }
+}
+
 TEST(AdaptiveSimulation, SmallFixedPatchIsResolvedExactly) {
   // A prescribed patch on the top face that contains no coarse vertex: the driver refines until
   // every finest vertex in the patch is interpolated from selected vertices only, so all of them

@@ -134,16 +134,19 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     m_obstacles = std::move(options.obstacles);
     for (const Obstacle& obstacle : m_obstacles)
       validate_obstacle(obstacle);
-    // Contact points on the mesh: every boundary vertex, then the extra points; each carried to
-    // the DOFs through the embedding's rows (a hanging vertex by its constraint).
+    // Contact points on the mesh: every boundary vertex (unless the options leave them out), then
+    // the extra points; each carried to the DOFs through the embedding's rows (a hanging vertex by
+    // its constraint).
     std::vector<ContactPoint> mesh_points;
-    std::vector<char> on_boundary(num_vertices, 0);
-    const MatrixX3i& faces = boundary();
-    for (Index f = 0; f < faces.rows(); ++f)
-      for (int k = 0; k < 3; ++k)
-        on_boundary[faces(f, k)] = 1;
-    for (Index v = 0; v < num_vertices; ++v)
-      if (on_boundary[v]) mesh_points.push_back({{static_cast<int>(v)}, {1.0}});
+    if (options.boundary_contact_points) {
+      std::vector<char> on_boundary(num_vertices, 0);
+      const MatrixX3i& faces = boundary();
+      for (Index f = 0; f < faces.rows(); ++f)
+        for (int k = 0; k < 3; ++k)
+          on_boundary[faces(f, k)] = 1;
+      for (Index v = 0; v < num_vertices; ++v)
+        if (on_boundary[v]) mesh_points.push_back({{static_cast<int>(v)}, {1.0}});
+    }
     for (const ContactPoint& point : options.contact_points) {
       if (point.vertices.empty() || point.vertices.size() != point.weights.size())
         throw InputError("simulation: a contact point needs one weight per vertex");

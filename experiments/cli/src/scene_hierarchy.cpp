@@ -14,7 +14,8 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
                        "refine_threshold", "coarsen_tolerance", "coarsen_indicator_fraction",
                        "stress_floor", "min_steps_between_changes", "max_active_elements",
                        "max_level", "balance", "tolerance", "initial_adaptation",
-                       "in_step_refinement", "full_resolution_fraction", "coarsen_budget", "cut"});
+                       "in_step_refinement", "full_resolution_fraction", "coarsen_budget", "cut",
+                       "finest_contact_points"});
   // clang-format on
   HierarchySettings settings;
   settings.levels = value.at("levels").integer(0);
@@ -53,6 +54,8 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
     settings.initial_adaptation = value.at("initial_adaptation").boolean();
   if (value.has("in_step_refinement"))
     settings.in_step_refinement = value.at("in_step_refinement").boolean();
+  if (value.has("finest_contact_points"))
+    settings.finest_contact_points = value.at("finest_contact_points").boolean();
   if (value.has("full_resolution_fraction")) {
     settings.full_resolution_fraction = value.at("full_resolution_fraction").positive();
     if (settings.full_resolution_fraction > 1.0)

@@ -323,6 +323,7 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
         {"friction_slip", contact.friction_slip},
         {"points", simulation.contact_points()},
         {"surface_points", simulation.extra_contact_points()},
+        {"finest_boundary_points", adaptive != nullptr && adaptive->finest_contact_points()},
         {"active_contacts", adaptive ? adaptive->contact_counts() : simulation.contact_counts()}};
   }
   if (scene.material.plasticity) {

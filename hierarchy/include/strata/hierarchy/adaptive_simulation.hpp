@@ -102,6 +102,12 @@ struct HierarchySettings {
   /// (merges_within_budget), so that coarsening alone does not lift the run over its tolerance;
   /// ∈ (0, 1].
   double coarsen_budget = 0.8;
+  /// With obstacles and no `contact_surface`: the finest level's boundary vertices
+  /// (finest_boundary_points), embedded in each cut, are the contact points in place of the cut's
+  /// boundary vertices (which are among them), so that an obstacle pressing between the vertices
+  /// of a coarse cut is felt there. false: the cut's boundary vertices only. Not in mode full,
+  /// whose boundary vertices are those points.
+  bool finest_contact_points = true;
   /// `criteria.refine_threshold` was given explicitly (an expert override of the tolerance rule).
   bool refine_threshold_set = false;
   RefinementSettings criteria;  ///< thresholds and hysteresis
@@ -194,7 +200,9 @@ class AdaptiveSimulation final : public SimulationRun {
   /// as in Simulation. Contact: `obstacles` (SimulationOptions::obstacles) are contacted by every
   /// active cut's boundary vertices, hanging ones included, and by the material points
   /// `contact_surface` (e.g. a fine surface's vertices, located in their roots), embedded in each
-  /// cut's active tets — so fine detail collides even on a coarse cut. The barrier stiffness is
+  /// cut's active tets — so fine detail collides even on a coarse cut. Without a
+  /// `contact_surface` the finest level's boundary vertices take the place of both
+  /// (HierarchySettings::finest_contact_points). The barrier stiffness is
   /// the same on every cut: E × the coarse mesh's mean edge length / 2^levels. Contact forces are
   /// loads for the criteria (CutState::external_forces), a parent is not coarsened while a
   /// contact force acts on its region, and a state carried to a new cut is pushed out of the
@@ -252,6 +260,9 @@ class AdaptiveSimulation final : public SimulationRun {
   const ToleranceReport& tolerance_report() const { return m_report; }
   /// Mode precomputed: the window of the schedule in use.
   std::size_t precomputed_window() const { return m_window; }
+  /// Obstacles: whether the finest level's boundary vertices are the contact points
+  /// (HierarchySettings::finest_contact_points).
+  bool finest_contact_points() const { return m_finest_contact; }
   /// Obstacles: the largest depth of any contact point inside an obstacle over the accepted
   /// steps [m], the contact pairs after each accepted step, and the barrier stiffness [N/m].
   double max_penetration() const { return m_max_penetration; }
@@ -325,6 +336,8 @@ class AdaptiveSimulation final : public SimulationRun {
   std::unique_ptr<RefinementController> m_controller;
   std::vector<Obstacle> m_obstacles;
   std::vector<RootPoint> m_contact_surface;
+  /// m_contact_surface holds the finest level's boundary vertices (in place of each cut's).
+  bool m_finest_contact = false;
   double m_contact_stiffness = 0.0;
   double m_max_penetration = 0.0;
   std::vector<Index> m_contact_counts;

@@ -65,6 +65,11 @@ CutPointWeights embed_point(const ActiveCut& cut, const FlatTreeMesh& flat, cons
 std::vector<CutPointWeights> embed_points(const ActiveCut& cut, const FlatTreeMesh& flat,
                                           const std::vector<RootPoint>& points);
 
+/// The vertices of the finest level on the boundary of `tree`'s coarse mesh: the lattice that L
+/// midpoint splits put on each coarse boundary triangle, each point once (with the root of one
+/// boundary triangle that holds it). Every boundary vertex of every cut is one of them.
+std::vector<RootPoint> finest_boundary_points(const TetTree& tree);
+
 /// Region loads spread on the finest level of `tree` (see the file comment), as point loads at
 /// the corners of the finest boundary triangles (or lattice points). `tolerance` [m] widens the
 /// regions (region_tolerance of the coarse mesh). Throws InputError naming a load whose region is

@@ -99,6 +99,10 @@ struct SimulationOptions {
   /// through their barycentric weights): the barrier and friction act on them too and their
   /// forces reach the DOFs through the weights.
   std::vector<ContactPoint> contact_points;
+  /// Whether every boundary vertex is a contact point (before `contact_points`). A driver whose
+  /// `contact_points` already hold the boundary vertices (the hierarchy's finest-level boundary
+  /// points) sets false.
+  bool boundary_contact_points = true;
   /// Barrier stiffness κ [N/m] of the obstacles; 0: E × this mesh's mean edge length. A driver
   /// that runs one scene on several meshes (the hierarchy's cuts) fixes it for all of them.
   double contact_stiffness = 0.0;
@@ -227,7 +231,8 @@ class Simulation final : public SimulationRun {
   bool has_obstacles() const { return !m_obstacles.empty(); }
   const ContactSettings& contact_settings() const;
   double max_penetration() const { return m_max_penetration; }
-  /// Points tested for contact (boundary vertices, then SimulationOptions::contact_points).
+  /// Points tested for contact (the boundary vertices unless SimulationOptions says otherwise,
+  /// then SimulationOptions::contact_points).
   Index contact_points() const { return static_cast<Index>(m_contact_points.size()); }
   /// Of those, the SimulationOptions::contact_points.
   Index extra_contact_points() const { return m_extra_contact_points; }
