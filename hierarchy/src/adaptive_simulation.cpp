@@ -24,6 +24,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// A state carried to a new cut is pushed out of the obstacles only where a contact point lies
+/// deeper than this share of d̂ (near the barrier's singularity at d̂), to this share.
+constexpr double kTransferPushOutDepth = 0.9;
+constexpr double kTransferPushOutTarget = 0.8;
+
 /// The mesh forces of `options` with every timed load at its peak.
 VectorXd peak_loads(const SimulationOptions& options) {
   VectorXd forces = options.extra_mesh_forces;
@@ -538,6 +543,16 @@ VectorXd AdaptiveSimulation::criteria_loads(const Simulation& simulation) {
   return m_mesh_external + contact;
 }
 
+bool AdaptiveSimulation::load_grows_before_next_decision() const {
+  if (is_static(m_solver)) return false;
+  // A merge made now stands until the next coarsening decision, adapt_every steps on.
+  const double t = time();
+  const double horizon = m_settings.adapt_every * m_solver.dt;
+  for (const auto& [amplitude, point_loads] : m_timed_point_loads)
+    if (amplitude.peak(t, t + horizon) > std::abs(amplitude.value(t))) return true;
+  return false;
+}
+
 CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
@@ -557,7 +572,10 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
       m_estimates_error && m_estimate.relative_error <= m_settings.tolerance;
   if (!coarsen && (!refine || within_tolerance)) return {};
   fields = sim.model().tet_fields(sim.positions());
-  m_decision_merges = coarsen;
+  // No merges while a load with an amplitude is still growing: the estimate of the current state
+  // cannot see a load that is still to come, and merges made where it will act would meet it on
+  // a coarse cut.
+  m_decision_merges = coarsen && !load_grows_before_next_decision();
   CutChanges changes = m_controller->decide(state, *m_cut);
   if (!refine || within_tolerance) {
     changes.refine.clear();
@@ -642,7 +660,12 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     m_simulation->set_state(constraints.restrict_to_free(x), constraints.restrict_to_free(v));
     keep_kinetic_energy(old_cut->flat, old_cut->constraints, old_dof_vertex_mass,
                         old_kinetic_energy, old_momentum);
-    if (!m_obstacles.empty()) record.contact_correction = m_simulation->push_out_of_obstacles();
+    // Only what the barrier's domain needs: a point in contact sits up to d̂ inside at
+    // equilibrium, and lifting it to the surface would release its contact (and its friction)
+    // for a step.
+    if (!m_obstacles.empty())
+      record.contact_correction =
+          m_simulation->push_out_of_obstacles(kTransferPushOutDepth, kTransferPushOutTarget);
     record.phases.transfer = lap();
   } catch (...) {
     // The previous cut comes back with a Simulation rebuilt on it at the state that was being

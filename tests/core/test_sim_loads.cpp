@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/amplitude.hpp"
 #include "strata/core/sim/loads.hpp"
 
 namespace strata {
@@ -76,6 +82,25 @@ TEST(SimLoads, GravityAndEmptyRegionError) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "loads[2]: region selects no vertex");
   }
+}
+
+TEST(SimLoads, AmplitudePeakOverAnIntervalIsTheLargestMagnitudeInIt) {
+  // Piecewise linear: the largest magnitude over [t0, t1] is at an end or at a table point
+  // between them. Checked against dense samples: never below them, and above by at most the
+  // steepest slope (100 /s) times the sample spacing.
+  Amplitude amplitude;
+  amplitude.points = {{0.0, 0.0}, {0.02, 1.0}, {0.05, -2.0}, {0.08, 0.5}};
+  for (const auto& [t0, t1] : std::vector<std::pair<double, double>>{
+           {0.0, 0.01}, {0.0, 0.03}, {0.03, 0.04}, {0.01, 0.07}, {0.06, 0.2}, {-1.0, 0.0}}) {
+    constexpr int kSamples = 10000;
+    double sampled = 0.0;
+    for (int k = 0; k <= kSamples; ++k)
+      sampled = std::max(sampled, std::abs(amplitude.value(t0 + (t1 - t0) * k / kSamples)));
+    const double peak = amplitude.peak(t0, t1);
+    EXPECT_GE(peak, sampled - 1e-15) << t0 << " " << t1;
+    EXPECT_LE(peak - sampled, 100.0 * (t1 - t0) / kSamples + 1e-15) << t0 << " " << t1;
+  }
+  EXPECT_EQ(amplitude.peak(0.0, 1.0), amplitude.peak());
 }
 
 }  // namespace

@@ -307,5 +307,41 @@ TEST(AdaptiveContact, PushOutMovesAnInfeasibleStateToTheSurface) {
   sim.advance();                                // and the barrier accepts it
 }
 
+TEST(AdaptiveContact, APushOutToADepthLeavesPointsInContactWhereTheyAre) {
+  // The push-out a cut change makes: only points near the barrier's singularity (deeper than
+  // 0.9 d̂) move, to 0.8 d̂; points at an equilibrium depth inside the obstacle stay in contact.
+  // Lifting those to the surface (the default push-out) released their contact force and, with
+  // friction, let them slide a step after every cut change.
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
+  const auto bottom_depths_after = [&](double depth, double push_depth, double to_depth,
+                                       double* moved) {
+    SimulationOptions options;
+    options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+    options.first_step = 1;
+    SolverSettings settings;
+    settings.dt = 1e-3;
+    settings.duration = 1.0;
+    settings.contact_distance = 1e-3;
+    Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
+                   std::move(options));
+    VectorXd x = flatten(mesh.vertices);
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -depth;
+    sim.set_state(x, VectorXd::Zero(x.size()));
+    *moved = sim.push_out_of_obstacles(push_depth, to_depth);
+    double deepest = 0.0;
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      deepest = std::max(deepest, -sim.positions()[3 * v + 2]);
+    return deepest;
+  };
+  double moved = 0.0;
+  EXPECT_NEAR(bottom_depths_after(3e-3, 0.9, 0.8, &moved), 0.8e-3, 1e-12);
+  EXPECT_NEAR(moved, 2.2e-3, 1e-12);
+  EXPECT_EQ(bottom_depths_after(0.7e-3, 0.9, 0.8, &moved), 0.7e-3);
+  EXPECT_EQ(moved, 0.0);
+  EXPECT_NEAR(bottom_depths_after(0.7e-3, 0.5, 0.0, &moved), 0.0, 1e-15);  // the default
+  EXPECT_NEAR(moved, 0.7e-3, 1e-12);
+}
+
 }  // namespace
 }  // namespace strata

@@ -341,6 +341,43 @@ TEST(AdaptiveTolerance, CoarseningKeepsTheEstimateWithinTheTolerance) {
     EXPECT_LE(sample.estimated_error, h.tolerance) << "step " << sample.step;
 }
 
+TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
+  // A slab clamped at its base; a patch load at its left end holds and then ramps down while one
+  // at its right end, idle at first, ramps up. The initial adaptation refines under both (every
+  // load at its peak). The decision at step 10 (t = 0.02 s) sees the right patch idle: when its
+  // load starts within the next 10 steps (at 0.03 s) nothing merges, so it does not meet its
+  // load on a coarse cut; when it starts only after them (at 0.045 s), the same decision merges.
+  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(0.6, 0.3, 0.1), {4, 2, 1});
+  Material material = rubber();
+  material.youngs_modulus = 1e5;
+  material.poisson_ratio = 0.35;
+  material.stiffness_damping = 0.001;
+  SolverSettings solver;
+  solver.integrator = Integrator::implicit_euler;
+  solver.dt = 0.002;
+  solver.duration = 0.03;
+  const auto merges_at_step_10 = [&](double right_start) {
+    RegionLoad left =
+        box_load(Vector3d(0.06, 0.12, 0.1), Vector3d(0.12, 0.18, 0.1), Vector3d(0, 0, -40.0));
+    left.amplitude.points = {{0.0, 1.0}, {0.03, 1.0}, {0.07, 0.0}};
+    RegionLoad right =
+        box_load(Vector3d(0.48, 0.12, 0.1), Vector3d(0.54, 0.18, 0.1), Vector3d(0, 0, -40.0));
+    right.name = "forces.1";
+    right.amplitude.points = {{0.0, 0.0}, {right_start, 0.0}, {0.07, 1.0}};
+    AdaptiveSimulation sim(coarse, defaults(2), material,
+                           {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
+                           {left, right}, std::nullopt, Vector3d::Zero(), solver);
+    while (sim.step_count() < 10)
+      sim.advance();
+    Index coarsened = 0;
+    for (const CutChangeRecord& change : sim.changes())
+      if (change.step == 10) coarsened += change.coarsened;
+    return coarsened;
+  };
+  EXPECT_EQ(merges_at_step_10(0.03), 0);
+  EXPECT_GT(merges_at_step_10(0.045), 0);
+}
+
 /// Values outside (0, 1] set by `set` are refused with an error naming hierarchy.`key`.
 void expect_fraction_refused(const std::string& key,
                              const std::function<void(HierarchySettings&, double)>& set) {

@@ -45,6 +45,14 @@ double Amplitude::peak() const {
   return peak;
 }
 
+double Amplitude::peak(double t0, double t1) const {
+  // Piecewise linear: the largest magnitude is at an end or at a table point between them.
+  double peak = std::max(std::abs(value(t0)), std::abs(value(t1)));
+  for (const auto& p : points)
+    if (p[0] > t0 && p[0] < t1) peak = std::max(peak, std::abs(p[1]));
+  return peak;
+}
+
 void validate_amplitude(const Amplitude& amplitude, const std::string& where) {
   for (size_t k = 0; k < amplitude.points.size(); ++k) {
     const auto& p = amplitude.points[k];

@@ -359,11 +359,11 @@ std::vector<Vector3d> Simulation::surface_contact_forces() const {
   return forces;
 }
 
-double Simulation::push_out_of_obstacles(double depth) {
+double Simulation::push_out_of_obstacles(double depth, double to_depth) {
   if (!m_contact) return 0.0;
   const double t = is_static() ? 0.0 : time();
   m_contact->set_step(m_x, t, t);
-  const double largest = m_contact->push_out(m_x, m_constrained, depth);
+  const double largest = m_contact->push_out(m_x, m_constrained, depth, to_depth);
   if (largest > 0.0) {
     update_mesh_state();
     m_stepper->reset_history();  // forces kept for the next step were at the old positions

@@ -241,9 +241,10 @@ void ContactTerm::require_feasible(ConstRef<VectorXd> q, const std::string& poin
     }
 }
 
-double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained,
-                             double depth) const {
+double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained, double depth,
+                             double to_depth) const {
   const double limit = depth * m_settings.distance;
+  const double target = std::min(to_depth, depth) * m_settings.distance;
   VectorXd moved = VectorXd::Zero(q.size());
   for (int pass = 0; pass < 20; ++pass) {
     VectorXd correction = VectorXd::Zero(q.size());
@@ -259,7 +260,7 @@ double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained,
         for (size_t k = 0; k < point.vertices.size(); ++k)
           if (!constrained[3 * point.vertices[k]]) weight_sq += point.weights[k] * point.weights[k];
         if (weight_sq == 0.0) continue;
-        const Vector3d lift = -phi * n.normalized() / weight_sq;
+        const Vector3d lift = (-phi - target) * n.normalized() / weight_sq;
         for (size_t k = 0; k < point.vertices.size(); ++k)
           for (int c = 0; c < 3; ++c)
             if (!constrained[3 * point.vertices[k] + c])

@@ -348,6 +348,9 @@ class AdaptiveSimulation final : public SimulationRun {
   /// The external loads the criteria see: m_mesh_external plus the contact forces (updating
   /// m_in_contact).
   VectorXd criteria_loads(const Simulation& simulation);
+  /// Dynamic runs: whether a load with an amplitude grows (its largest magnitude over the next
+  /// adapt_every steps exceeds its magnitude now) before the next coarsening decision.
+  bool load_grows_before_next_decision() const;
   std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
   /// Loads with an amplitude, each on the finest level.
   std::vector<std::pair<Amplitude, std::vector<PointLoad>>> m_timed_point_loads;

@@ -27,6 +27,8 @@ struct Amplitude {
   double rate(double t) const;
   /// max_t |s(t)|.
   double peak() const;
+  /// max |s(t)| over t0 ≤ t ≤ t1 (needs a table).
+  double peak(double t0, double t1) const;
 };
 
 /// Throws InputError naming `where` (e.g. "forces[1].amplitude") unless every point is finite

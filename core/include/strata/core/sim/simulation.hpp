@@ -250,11 +250,12 @@ class Simulation final : public SimulationRun {
   std::vector<Vector3d> surface_contact_forces() const;
   /// Moves free DOF vertices so that no contact point lies deeper than `depth` × the contact
   /// tolerance inside an obstacle at the current time (each deeper point is pushed out along ∇φ
-  /// to the surface, its correction shared over its DOF vertices by weight, repeated up to 20
-  /// times). For a state carried over from another mesh (a cut change near curved obstacles,
-  /// where new vertices on the old linear field can lie inside). Returns the largest correction of
-  /// a DOF vertex [m] (0 when the state was feasible); velocities are unchanged.
-  double push_out_of_obstacles(double depth = 0.5);
+  /// to `to_depth` × the tolerance inside, 0: to the surface, its correction shared over its DOF
+  /// vertices by weight, repeated up to 20 times). For a state carried over from another mesh (a
+  /// cut change near curved obstacles, where new vertices on the old linear field can lie
+  /// inside). Returns the largest correction of a DOF vertex [m] (0 when the state was feasible);
+  /// velocities are unchanged.
+  double push_out_of_obstacles(double depth = 0.5, double to_depth = 0.0);
   /// Whether the material is plastic.
   bool is_plastic() const { return m_material.plasticity.has_value(); }
   /// Plastic state per mesh tet (empty unless is_plastic()).
