@@ -158,8 +158,9 @@ AdaptiveSimulation::AdaptiveSimulation(
   for (const RootPoint& point : m_contact_surface)
     if (point.root < 0 || point.root >= m_tree->num_roots() || !point.position.allFinite())
       throw InputError("contact surface: a point needs a root tet and a finite position");
+  // Explicit steps project the DOF vertices out of the obstacles and use no contact points.
   if (!m_obstacles.empty() && m_contact_surface.empty() && m_settings.finest_contact_points &&
-      m_settings.mode != HierarchyMode::full && m_settings.levels > 0) {
+      m_settings.mode != HierarchyMode::full && m_settings.levels > 0 && !is_explicit(m_solver)) {
     m_contact_surface = finest_boundary_points(*m_tree);
     m_finest_contact = true;
   }
@@ -195,9 +196,10 @@ AdaptiveSimulation::AdaptiveSimulation(
     return !m_in_contact.contains(parent) &&
            dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
   });
-  // The merges of a decision: none where it only refines; with the error estimate, those within
-  // the coarsening budget. Chosen before the controller fits the refinements to the element
-  // budget, which counts the tets the merges free.
+  // The merges of a decision: none where it only refines or while a load with an amplitude is
+  // still growing (decide); with the error estimate, those within the coarsening budget. Chosen
+  // before the controller fits the refinements to the element budget, which counts the tets the
+  // merges free.
   m_controller->set_merge_filter(
       [this](const CutState& state, const std::vector<NodeId>& parents) -> std::vector<NodeId> {
         if (!m_decision_merges) return {};
@@ -459,6 +461,10 @@ void AdaptiveSimulation::advance() {
   }
   const auto start = Clock::now();
   m_estimate_valid = false;
+  // With obstacles, friction in a re-solve measures slip from the start of the load step (carried
+  // to each new cut), not from the previous pass's solution on a coarser cut.
+  if (adapting() && is_static(m_solver) && !m_obstacles.empty())
+    m_load_step_start = m_simulation->positions();
   m_simulation->advance();
   m_stepping_seconds += seconds_since(start);
   if (adapting() && is_static(m_solver)) {
@@ -466,10 +472,14 @@ void AdaptiveSimulation::advance() {
     for (int pass = 0; pass < m_settings.max_passes && adapting() && adapt(pass, true, true);
          ++pass) {
       const auto solve_start = Clock::now();
-      m_simulation->resolve_static();
+      m_simulation->resolve_static(
+          m_load_step_start.size() > 0
+              ? m_constrained->constraints.restrict_to_free(m_load_step_start)
+              : VectorXd());
       m_stepping_seconds += seconds_since(solve_start);
     }
   }
+  m_load_step_start.resize(0);
   record_contact_step();
   if (adapting() && !is_static(m_solver) && step_count() % m_settings.adapt_every == 0 &&
       !finished())
@@ -548,8 +558,11 @@ bool AdaptiveSimulation::load_grows_before_next_decision() const {
   // A merge made now stands until the next coarsening decision, adapt_every steps on.
   const double t = time();
   const double horizon = m_settings.adapt_every * m_solver.dt;
+  // A plateau's interpolated values differ from the table's in the last bits: growth is a rise
+  // beyond round-off of the load's peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads)
-    if (amplitude.peak(t, t + horizon) > std::abs(amplitude.value(t))) return true;
+    if (amplitude.peak(t, t + horizon) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak())
+      return true;
   return false;
 }
 
@@ -654,6 +667,9 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
     const HangingConstraints& constraints = m_constrained->constraints;
     const VectorXd x = transfer_vertex_values(*m_tree, old_cut->flat, x_mesh, new_flat);
     const VectorXd v = transfer_vertex_values(*m_tree, old_cut->flat, v_mesh, new_flat);
+    if (m_load_step_start.size() > 0)
+      m_load_step_start =
+          transfer_vertex_values(*m_tree, old_cut->flat, m_load_step_start, new_flat);
     if (!plastic.empty())
       m_simulation->set_plastic_state(transfer_plastic_state(
           *m_tree, old_cut->flat, plastic, new_flat, &record.plastic_merge_change));

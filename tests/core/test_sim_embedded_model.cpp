@@ -158,8 +158,8 @@ TEST(EmbeddedElasticModel, ExpandAndReduceAreTheProlongationAndItsTranspose) {
 }
 
 TEST(EmbeddedElasticModel, ReducedStiffnessDoesNotDependOnTheThreadCount) {
-  // The layer of tets at the tied vertices adds into K by value ranges, one per thread: K is the
-  // same to the bit at 1, 2 and 8 threads.
+  // The layer of tets at the tied vertices adds into K by ranges of its values, in parallel: K is
+  // the same to the bit at 1, 2 and 8 threads.
   const TiedBox box({40, 10, 10});
   const ElasticModel model(box.mesh.vertices, box.mesh.tets, test_material(MaterialModel::stvk));
   const EmbeddedElasticModel embedded(model, box.C, box.dof_vertices);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -305,6 +306,47 @@ TEST(AdaptiveContact, PushOutMovesAnInfeasibleStateToTheSurface) {
   }
   EXPECT_EQ(sim.push_out_of_obstacles(), 0.0);  // feasible now
   sim.advance();                                // and the barrier accepts it
+}
+
+TEST(AdaptiveContact, APushOutOfPointsSharingVerticesDoesNotOvershoot) {
+  // 25 contact points embedded in a block's bottom face (bilinear weights on its four corners,
+  // as the finest level's points on a coarse face are), all 0.95 d̂ inside a plane: the push-out
+  // to 0.8 d̂ moves the shared corners by about 0.15 d̂, leaving every point in contact. Summed,
+  // the points' lifts moved the corners by several d̂, out of the plane.
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
+  std::array<int, 4> corner{};  // (0,0), (1,0), (0,1), (1,1) of the bottom face
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    if (mesh.vertices(v, 2) == 0.0)
+      corner[(mesh.vertices(v, 0) > 0.0 ? 1 : 0) + (mesh.vertices(v, 1) > 0.0 ? 2 : 0)] =
+          static_cast<int>(v);
+  SimulationOptions options;
+  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+  options.boundary_contact_points = false;
+  for (int i = 0; i <= 4; ++i)
+    for (int j = 0; j <= 4; ++j) {
+      const double a = i / 4.0, b = j / 4.0;
+      options.contact_points.push_back({{corner[0], corner[1], corner[2], corner[3]},
+                                        {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b}});
+    }
+  options.first_step = 1;
+  SolverSettings settings;
+  settings.dt = 1e-3;
+  settings.duration = 1.0;
+  settings.contact_distance = 1e-3;
+  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
+                 std::move(options));
+  VectorXd x = flatten(mesh.vertices);
+  for (Index v = 0; v < mesh.vertices.rows(); ++v)
+    if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -0.95e-3;
+  sim.set_state(x, VectorXd::Zero(x.size()));
+  const double moved = sim.push_out_of_obstacles(0.9, 0.8);
+  EXPECT_GT(moved, 0.1e-3);
+  EXPECT_LT(moved, 0.2e-3);
+  for (const int v : corner) {
+    const double depth = -sim.positions()[3 * v + 2];
+    EXPECT_GE(depth, 0.7e-3);
+    EXPECT_LE(depth, 0.9e-3);
+  }
 }
 
 TEST(AdaptiveContact, APushOutToADepthLeavesPointsInContactWhereTheyAre) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "strata/core/common/error.hpp"
 
@@ -46,6 +47,7 @@ double Amplitude::peak() const {
 }
 
 double Amplitude::peak(double t0, double t1) const {
+  if (t1 < t0) std::swap(t0, t1);
   // Piecewise linear: the largest magnitude is at an end or at a table point between them.
   double peak = std::max(std::abs(value(t0)), std::abs(value(t1)));
   for (const auto& p : points)

@@ -238,8 +238,8 @@ void EmbeddedElasticModel::group_layer_additions(const FillVector<int>& block_ta
   const auto num_blocks = static_cast<Index>(block_targets.size());
   m_num_layer_blocks = num_blocks;
   // Fixed chunks of blocks (the additions of chunk c come before those of chunk c + 1 in every
-  // range) and slices of K_q's values 2^shift long (at most 2 · kTargetBins of them); a range is a
-  // run of slices.
+  // range) and slices of K_q's values 2^shift long (at most kTargetBins of them); a range is a run
+  // of slices.
   constexpr Index kTargetBins = 512;
   constexpr Index kRanges = 16;
   int shift = 0;

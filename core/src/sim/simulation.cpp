@@ -461,7 +461,7 @@ void Simulation::update_plastic_state(double t0, double t1, double h, const Vect
     // The step again, with the relaxed plastic state.
     NewtonResult result;
     if (is_static()) {
-      result = m_stepper->resolve(t1, m_x, m_v);
+      result = m_stepper->resolve(t1, m_x, m_v, VectorXd());
     } else {
       m_x = q_start;
       m_v = v_start;
@@ -489,11 +489,11 @@ void Simulation::throw_newton_failure(const std::string& context, int iterations
                         step, t);
 }
 
-void Simulation::resolve_static() {
+void Simulation::resolve_static(const VectorXd& contact_reference) {
   STRATA_VERIFY(is_static() && m_steps > 0,
                 "Simulation::resolve_static needs static mode after a load step");
   const double lambda = load_factor();
-  const NewtonResult result = m_stepper->resolve(lambda, m_x, m_v);
+  const NewtonResult result = m_stepper->resolve(lambda, m_x, m_v, contact_reference);
   record_newton(result);
   if (!result.converged)
     throw DivergenceError("static: Newton did not converge re-solving load step " +

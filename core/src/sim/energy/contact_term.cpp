@@ -247,7 +247,11 @@ double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained, 
   const double target = std::min(to_depth, depth) * m_settings.distance;
   VectorXd moved = VectorXd::Zero(q.size());
   for (int pass = 0; pass < 20; ++pass) {
+    // Each deep point's least-norm lift, averaged over the points that share a DOF: points
+    // embedded in one coarse face (a fine surface, the finest level's boundary) move its few
+    // vertices together, and their summed lifts would overshoot by their number.
     VectorXd correction = VectorXd::Zero(q.size());
+    VectorXd sharing = VectorXd::Zero(q.size());
     bool inside = false;
     for (const Obstacle& obstacle : m_obstacles)
       for (Index p = 0; p < num_points(); ++p) {
@@ -263,10 +267,14 @@ double ContactTerm::push_out(VectorXd& q, const std::vector<char>& constrained, 
         const Vector3d lift = (-phi - target) * n.normalized() / weight_sq;
         for (size_t k = 0; k < point.vertices.size(); ++k)
           for (int c = 0; c < 3; ++c)
-            if (!constrained[3 * point.vertices[k] + c])
+            if (!constrained[3 * point.vertices[k] + c] && point.weights[k] != 0.0) {
               correction[3 * point.vertices[k] + c] += point.weights[k] * lift[c];
+              sharing[3 * point.vertices[k] + c] += 1.0;
+            }
       }
     if (!inside) break;
+    for (Index i = 0; i < correction.size(); ++i)
+      if (sharing[i] > 1.0) correction[i] /= sharing[i];
     q += correction;
     moved += correction;
   }

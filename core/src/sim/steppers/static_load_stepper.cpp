@@ -27,8 +27,11 @@ NewtonResult StaticLoadStepper::step(double, double t1, double, VectorXd& q, Vec
   return result;
 }
 
-NewtonResult StaticLoadStepper::resolve(double t, VectorXd& q, VectorXd& v) {
+NewtonResult StaticLoadStepper::resolve(double t, VectorXd& q, VectorXd& v,
+                                        const VectorXd& contact_reference) {
   VectorXd guess = q;
+  if (m_problem.has_obstacles() && contact_reference.size() == q.size())
+    m_solver.set_contact_reference(contact_reference);
   const NewtonResult result = m_solver.solve(t, guess);
   if (!result.converged) return result;
   q = guess;

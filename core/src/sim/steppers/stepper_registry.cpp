@@ -7,7 +7,7 @@
 
 namespace strata {
 
-NewtonResult TimeStepper::resolve(double, VectorXd&, VectorXd&) {
+NewtonResult TimeStepper::resolve(double, VectorXd&, VectorXd&, const VectorXd&) {
   throw std::logic_error("TimeStepper::resolve: only static load stepping re-solves a step");
 }
 

@@ -206,9 +206,9 @@ class AdaptiveSimulation final : public SimulationRun {
   /// the same on every cut: E × the coarse mesh's mean edge length / 2^levels. Contact forces are
   /// loads for the criteria (CutState::external_forces), a parent is not coarsened while a
   /// contact force acts on its region, and a state carried to a new cut is pushed out of the
-  /// obstacles where new vertices on the old field lie inside one
-  /// (Simulation::push_out_of_obstacles, CutChangeRecord::contact_correction). Throws InputError
-  /// for invalid settings or scene data.
+  /// obstacles where a contact point on the old field lies deeper than 0.9 d̂ inside one, to
+  /// 0.8 d̂ (Simulation::push_out_of_obstacles, CutChangeRecord::contact_correction). Throws
+  /// InputError for invalid settings or scene data.
   AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
                      const Material& material, std::vector<DirichletSpec> dirichlet,
                      const std::vector<RegionLoad>& loads, std::optional<GroundPlane> ground,
@@ -348,6 +348,10 @@ class AdaptiveSimulation final : public SimulationRun {
   /// The external loads the criteria see: m_mesh_external plus the contact forces (updating
   /// m_in_contact).
   VectorXd criteria_loads(const Simulation& simulation);
+  /// Static runs with obstacles, during a load step's passes: the state at the start of the load
+  /// step (mesh positions of the current cut, carried with each change), from which friction in
+  /// a re-solve measures slip; empty otherwise.
+  VectorXd m_load_step_start;
   /// Dynamic runs: whether a load with an amplitude grows (its largest magnitude over the next
   /// adapt_every steps exceeds its magnitude now) before the next coarsening decision.
   bool load_grows_before_next_decision() const;

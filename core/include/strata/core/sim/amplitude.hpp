@@ -27,7 +27,7 @@ struct Amplitude {
   double rate(double t) const;
   /// max_t |s(t)|.
   double peak() const;
-  /// max |s(t)| over t0 ≤ t ≤ t1 (needs a table).
+  /// max |s(t)| over the interval between t0 and t1 (needs a table).
   double peak(double t0, double t1) const;
 };
 

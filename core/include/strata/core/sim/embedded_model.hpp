@@ -94,8 +94,9 @@ class EmbeddedElasticModel {
     double weight;
   };
   void build_reduced_pattern();
-  /// m_layer_additions and m_range_begin from the layer blocks' targets (block_targets as
-  /// described at m_layer_additions, weighted the entries they point to).
+  /// m_layer_additions and m_range_begin from the layer blocks' targets: per block (3-value column
+  /// g, in order) the reduced value it adds to with weight 1 (≥ 0), or ~n (< 0): it adds through
+  /// the next n entries of `weighted`.
   void group_layer_additions(const FillVector<int>& block_targets,
                              const FillVector<WeightedTarget>& weighted);
 

@@ -91,9 +91,10 @@ struct SimulationOptions {
   /// Surface springs with yielding rest lengths (surface_springs.hpp) on the mesh's boundary
   /// edges; meshes without an embedding only.
   std::optional<SurfaceSpringSettings> surface_springs;
-  /// Rigid obstacles (obstacle.hpp) the boundary vertices contact through a barrier (implicit
-  /// and static steps) or a projection (explicit steps, DOF vertices only). With an embedding a
-  /// hanging boundary vertex is tested where its constraint puts it.
+  /// Rigid obstacles (obstacle.hpp) the contact points (the boundary vertices unless
+  /// `boundary_contact_points` is false, and `contact_points`) contact through a barrier (implicit
+  /// and static steps), or the DOF vertices through a projection (explicit steps). With an
+  /// embedding a hanging boundary vertex is tested where its constraint puts it.
   std::vector<Obstacle> obstacles;
   /// Further contact points as weighted mesh vertices (e.g. the vertices of a bound fine surface,
   /// through their barycentric weights): the barrier and friction act on them too and their
@@ -165,8 +166,10 @@ class Simulation final : public SimulationRun {
   /// current state (e.g. after a driver carried the state over to a new mesh with
   /// SimulationOptions::first_step = the step just taken). The step count is unchanged; the next
   /// load step starts from this solution without extrapolation. Throws DivergenceError as
-  /// advance(); std::logic_error in dynamic mode or before the first load step.
-  void resolve_static();
+  /// advance(); std::logic_error in dynamic mode or before the first load step. With obstacles,
+  /// `contact_reference` (3·#Q; empty: the current state) is the state friction measures slip
+  /// from: the start of the load step, carried to this mesh.
+  void resolve_static(const VectorXd& contact_reference = VectorXd());
   /// Dynamic: t ≥ duration (up to 10⁻⁹ dt; the last step is not shortened, so the run takes
   /// ⌈duration/dt⌉ steps). Static: all load_steps done.
   bool finished() const override;
@@ -225,8 +228,8 @@ class Simulation final : public SimulationRun {
   VectorXd current_external_forces() const;
   const DivergenceLimits& divergence_limits() const { return m_limits; }
   /// Obstacle contact: the settings (tolerance d̂, barrier stiffness κ = E × mean edge length,
-  /// friction slip), the largest depth of a boundary vertex inside an obstacle after any step so
-  /// far [m], the vertex–obstacle pairs in contact after each step, and the contact forces the
+  /// friction slip), the largest depth of a contact point inside an obstacle after any step so
+  /// far [m], the point–obstacle pairs in contact after each step, and the contact forces the
   /// obstacles exert now (3·#Q [N], normal and friction).
   bool has_obstacles() const { return !m_obstacles.empty(); }
   const ContactSettings& contact_settings() const;

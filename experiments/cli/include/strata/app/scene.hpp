@@ -43,7 +43,7 @@ struct MeshSpec {
   std::array<int, 3> box_cells{1, 1, 1};  ///< hexahedral cells per axis (6 tets each)
 };
 
-/// One entry of "obstacles": a rigid body the boundary vertices contact (obstacle.hpp); exactly
+/// One entry of "obstacles": a rigid body the contact points contact (obstacle.hpp); exactly
 /// one of plane, implicit, level_set, surface.
 struct ObstacleSpec {
   std::string name;  ///< its key path, "obstacles.0"

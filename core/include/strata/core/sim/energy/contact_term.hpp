@@ -72,10 +72,10 @@ class ContactTerm final : public EnergyTerm {
   /// Moves the free DOFs of `q` (`constrained`: 3·#Q mask, as Problem::constrained) so that no
   /// point lies deeper than `depth` × d̂ inside an obstacle at the end-of-step placement: each
   /// deeper point is lifted along ∇φ to `to_depth` × d̂ inside (0: to the surface; at most
-  /// `depth`) by the least-norm move of its free vertices, repeated up to 20 times (points sharing
-  /// vertices). Returns the largest move of a vertex [m] (0 when q was feasible). For a start that
-  /// the barrier's domain excludes: an obstacle that moved into the body within a step, or a state
-  /// carried over from another mesh.
+  /// `depth`) by the least-norm move of its free vertices, the moves of points that share a
+  /// vertex averaged there, repeated up to 20 times. Returns the largest move of a vertex [m] (0
+  /// when q was feasible). For a start that the barrier's domain excludes: an obstacle that moved
+  /// into the body within a step, or a state carried over from another mesh.
   double push_out(VectorXd& q, const std::vector<char>& constrained, double depth,
                   double to_depth = 0.0) const;
   /// Throws InputError "<obstacle>: <point_name> p starts D m inside the obstacle (more than the

@@ -12,7 +12,8 @@ class StaticLoadStepper final : public TimeStepper {
  public:
   StaticLoadStepper(const Problem& problem, const SolverSettings& settings);
   NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
-  NewtonResult resolve(double t, VectorXd& q, VectorXd& v) override;
+  NewtonResult resolve(double t, VectorXd& q, VectorXd& v,
+                       const VectorXd& contact_reference) override;
   void reset_history() override { m_has_previous = false; }
   const SpdSolver* linear_solver() const override { return &m_solver.linear_solver(); }
   const EnergySum* energy() const override { return &m_solver.energy(); }

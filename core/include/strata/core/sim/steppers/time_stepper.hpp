@@ -28,8 +28,10 @@ class TimeStepper {
   /// at the start of the step.
   virtual NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) = 0;
   /// Re-solves the state at t (static load stepping after the state moved to a new cut); other
-  /// steppers throw std::logic_error.
-  virtual NewtonResult resolve(double t, VectorXd& q, VectorXd& v);
+  /// steppers throw std::logic_error. `contact_reference` (3·#Q, or empty: q): the state friction
+  /// measures slip from, the start of the load step carried to the new cut.
+  virtual NewtonResult resolve(double t, VectorXd& q, VectorXd& v,
+                               const VectorXd& contact_reference);
   /// The state was replaced (initial state, a new cut, a new plastic state): no step history
   /// carries over.
   virtual void reset_history() {}
