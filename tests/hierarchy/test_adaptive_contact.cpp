@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -279,33 +280,51 @@ TEST(AdaptiveContact, ASlidingSphereIsRefinedUnderAndReleasedBehind) {
   EXPECT_GT(coarsened, 0);
 }
 
+/// A 0.1 m block on a plane (d̂ = 1 mm), continued from a state whose bottom vertices lie
+/// `depth` inside the plane: the push-out tests' setting. `options` adds contact points.
+struct SunkBlock {
+  TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
+
+  std::unique_ptr<Simulation> sink(double depth, SimulationOptions options = {}) const {
+    options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
+    options.first_step = 1;  // a continued run: its state comes from set_state
+    SolverSettings settings;
+    settings.dt = 1e-3;
+    settings.duration = 1.0;
+    settings.contact_distance = 1e-3;
+    auto sim = std::make_unique<Simulation>(mesh, rubber(), std::vector<DirichletSpec>{},
+                                            std::vector<RegionLoad>{}, std::nullopt,
+                                            Vector3d::Zero(), settings, std::move(options));
+    VectorXd x = flatten(mesh.vertices);
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -depth;
+    sim->set_state(x, VectorXd::Zero(x.size()));
+    return sim;
+  }
+  /// The largest depth of a vertex inside the plane.
+  double deepest(const Simulation& sim) const {
+    double deepest = 0.0;
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      deepest = std::max(deepest, -sim.positions()[3 * v + 2]);
+    return deepest;
+  }
+};
+
 TEST(AdaptiveContact, PushOutMovesAnInfeasibleStateToTheSurface) {
   // A block whose bottom vertices are moved 3 mm into a plane (deeper than the 1 mm tolerance):
   // the push-out lifts them to the plane and leaves the others.
-  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
-  SimulationOptions options;
-  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
-  options.first_step = 1;  // a continued run: its state comes from set_state
-  SolverSettings settings;
-  settings.dt = 1e-3;
-  settings.duration = 1.0;
-  settings.contact_distance = 1e-3;
-  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
-                 std::move(options));
-  VectorXd x = flatten(mesh.vertices);
-  for (Index v = 0; v < mesh.vertices.rows(); ++v)
-    if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -3e-3;
-  sim.set_state(x, VectorXd::Zero(x.size()));
-  EXPECT_NEAR(sim.push_out_of_obstacles(), 3e-3, 1e-12);
-  for (Index v = 0; v < mesh.vertices.rows(); ++v) {
-    const double z = sim.positions()[3 * v + 2];
+  const SunkBlock block;
+  const std::unique_ptr<Simulation> sim = block.sink(3e-3);
+  EXPECT_NEAR(sim->push_out_of_obstacles(), 3e-3, 1e-12);
+  for (Index v = 0; v < block.mesh.vertices.rows(); ++v) {
+    const double z = sim->positions()[3 * v + 2];
     EXPECT_GE(z, -0.5e-3);
-    if (mesh.vertices(v, 2) > 0.0) {
-      EXPECT_EQ(z, mesh.vertices(v, 2));
+    if (block.mesh.vertices(v, 2) > 0.0) {
+      EXPECT_EQ(z, block.mesh.vertices(v, 2));
     }
   }
-  EXPECT_EQ(sim.push_out_of_obstacles(), 0.0);  // feasible now
-  sim.advance();                                // and the barrier accepts it
+  EXPECT_EQ(sim->push_out_of_obstacles(), 0.0);  // feasible now
+  sim->advance();                                // and the barrier accepts it
 }
 
 TEST(AdaptiveContact, APushOutOfPointsSharingVerticesDoesNotOvershoot) {
@@ -313,14 +332,13 @@ TEST(AdaptiveContact, APushOutOfPointsSharingVerticesDoesNotOvershoot) {
   // as the finest level's points on a coarse face are), all 0.95 d̂ inside a plane: the push-out
   // to 0.8 d̂ moves the shared corners by about 0.15 d̂, leaving every point in contact. Summed,
   // the points' lifts moved the corners by several d̂, out of the plane.
-  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
+  const SunkBlock block;
   std::array<int, 4> corner{};  // (0,0), (1,0), (0,1), (1,1) of the bottom face
-  for (Index v = 0; v < mesh.vertices.rows(); ++v)
-    if (mesh.vertices(v, 2) == 0.0)
-      corner[(mesh.vertices(v, 0) > 0.0 ? 1 : 0) + (mesh.vertices(v, 1) > 0.0 ? 2 : 0)] =
-          static_cast<int>(v);
+  for (Index v = 0; v < block.mesh.vertices.rows(); ++v)
+    if (block.mesh.vertices(v, 2) == 0.0)
+      corner[(block.mesh.vertices(v, 0) > 0.0 ? 1 : 0) +
+             (block.mesh.vertices(v, 1) > 0.0 ? 2 : 0)] = static_cast<int>(v);
   SimulationOptions options;
-  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
   options.boundary_contact_points = false;
   for (int i = 0; i <= 4; ++i)
     for (int j = 0; j <= 4; ++j) {
@@ -328,22 +346,12 @@ TEST(AdaptiveContact, APushOutOfPointsSharingVerticesDoesNotOvershoot) {
       options.contact_points.push_back({{corner[0], corner[1], corner[2], corner[3]},
                                         {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b}});
     }
-  options.first_step = 1;
-  SolverSettings settings;
-  settings.dt = 1e-3;
-  settings.duration = 1.0;
-  settings.contact_distance = 1e-3;
-  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
-                 std::move(options));
-  VectorXd x = flatten(mesh.vertices);
-  for (Index v = 0; v < mesh.vertices.rows(); ++v)
-    if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -0.95e-3;
-  sim.set_state(x, VectorXd::Zero(x.size()));
-  const double moved = sim.push_out_of_obstacles(0.9, 0.8);
+  const std::unique_ptr<Simulation> sim = block.sink(0.95e-3, std::move(options));
+  const double moved = sim->push_out_of_obstacles(0.9, 0.8);
   EXPECT_GT(moved, 0.1e-3);
   EXPECT_LT(moved, 0.2e-3);
   for (const int v : corner) {
-    const double depth = -sim.positions()[3 * v + 2];
+    const double depth = -sim->positions()[3 * v + 2];
     EXPECT_GE(depth, 0.7e-3);
     EXPECT_LE(depth, 0.9e-3);
   }
@@ -354,35 +362,16 @@ TEST(AdaptiveContact, APushOutToADepthLeavesPointsInContactWhereTheyAre) {
   // 0.9 d̂) move, to 0.8 d̂; points at an equilibrium depth inside the obstacle stay in contact.
   // Lifting those to the surface (the default push-out) released their contact force and, with
   // friction, let them slide a step after every cut change.
-  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
-  const auto bottom_depths_after = [&](double depth, double push_depth, double to_depth,
-                                       double* moved) {
-    SimulationOptions options;
-    options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
-    options.first_step = 1;
-    SolverSettings settings;
-    settings.dt = 1e-3;
-    settings.duration = 1.0;
-    settings.contact_distance = 1e-3;
-    Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
-                   std::move(options));
-    VectorXd x = flatten(mesh.vertices);
-    for (Index v = 0; v < mesh.vertices.rows(); ++v)
-      if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -depth;
-    sim.set_state(x, VectorXd::Zero(x.size()));
-    *moved = sim.push_out_of_obstacles(push_depth, to_depth);
-    double deepest = 0.0;
-    for (Index v = 0; v < mesh.vertices.rows(); ++v)
-      deepest = std::max(deepest, -sim.positions()[3 * v + 2]);
-    return deepest;
-  };
-  double moved = 0.0;
-  EXPECT_NEAR(bottom_depths_after(3e-3, 0.9, 0.8, &moved), 0.8e-3, 1e-12);
-  EXPECT_NEAR(moved, 2.2e-3, 1e-12);
-  EXPECT_EQ(bottom_depths_after(0.7e-3, 0.9, 0.8, &moved), 0.7e-3);
-  EXPECT_EQ(moved, 0.0);
-  EXPECT_NEAR(bottom_depths_after(0.7e-3, 0.5, 0.0, &moved), 0.0, 1e-15);  // the default
-  EXPECT_NEAR(moved, 0.7e-3, 1e-12);
+  const SunkBlock block;
+  std::unique_ptr<Simulation> sim = block.sink(3e-3);
+  EXPECT_NEAR(sim->push_out_of_obstacles(0.9, 0.8), 2.2e-3, 1e-12);
+  EXPECT_NEAR(block.deepest(*sim), 0.8e-3, 1e-12);
+  sim = block.sink(0.7e-3);
+  EXPECT_EQ(sim->push_out_of_obstacles(0.9, 0.8), 0.0);
+  EXPECT_EQ(block.deepest(*sim), 0.7e-3);
+  sim = block.sink(0.7e-3);
+  EXPECT_NEAR(sim->push_out_of_obstacles(), 0.7e-3, 1e-12);  // the default: to the surface
+  EXPECT_NEAR(block.deepest(*sim), 0.0, 1e-15);
 }
 
 }  // namespace
