@@ -2,7 +2,7 @@
 """Error of hierarchy runs against full resolution, over the whole run.
 
 Runs a scene (which has a "hierarchy" key) once with hierarchy.mode=full — the reference, reused
-when its outputs are present — and once per configuration given with --run NAME:key=value,... The
+when its outputs are present from the same command, scene file and strata binary — and once per configuration given with --run NAME:key=value,... The
 error of a run is the largest probe-displacement difference to the full run over every frame and
 probe, relative to the largest full-resolution probe displacement (the measure hierarchy.tolerance
 bounds). Prints one line per run and writes <out>/compare.json:
@@ -18,6 +18,7 @@ writing them does not enter the speed-ups.
 """
 import argparse
 import csv
+import hashlib
 import json
 import os
 import subprocess
@@ -36,6 +37,15 @@ def read_probes(folder):
     return frames
 
 
+def fingerprint(args, command):
+    """What a run's outputs depend on: the command, the scene file's bytes, the binary."""
+    with open(args.scene, "rb") as f:
+        scene = hashlib.sha256(f.read()).hexdigest()
+    binary = os.stat(args.strata)
+    return {"command": command, "scene_sha256": scene,
+            "strata": [binary.st_size, binary.st_mtime_ns]}
+
+
 def run(args, name, settings, frames=False):
     folder = os.path.join(args.out, name + ("-frames" if frames else ""))
     stats_path = os.path.join(folder, "stats.json")
@@ -47,14 +57,21 @@ def run(args, name, settings, frames=False):
         command += ["--set", f"hierarchy.{key}={value}"]
     if frames:
         command += ["--set", "output.vtk_encoding=binary"]
+    key = fingerprint(args, command)
+    key_path = os.path.join(folder, "compare_run.json")
     if name == "full" and os.path.exists(stats_path) and not args.rerun_full:
-        return json.load(open(stats_path)), folder
+        if os.path.exists(key_path) and json.load(open(key_path)) == key:
+            return json.load(open(stats_path)), folder
+    if os.path.exists(key_path):
+        os.remove(key_path)
     start = time.monotonic()
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
         sys.exit(f"compare_to_full: {name} failed ({result.returncode}): {result.stderr.strip()}")
     stats = json.load(open(stats_path))
     stats["measured_seconds"] = time.monotonic() - start
+    with open(key_path, "w") as f:
+        json.dump(key, f)
     return stats, folder
 
 

@@ -108,6 +108,57 @@ double LevelSet::signed_distance_and_gradient(const Vector3d& p, Vector3d& gradi
   return phi;
 }
 
+namespace {
+
+/// Catmull-Rom weights of the samples at −1, 0, 1, 2 for a point t ∈ [0, 1) past sample 0, and
+/// their derivatives in t.
+void catmull_rom_weights(double t, double w[4], double dw[4]) {
+  const double t2 = t * t, t3 = t2 * t;
+  w[0] = 0.5 * (-t3 + 2.0 * t2 - t);
+  w[1] = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+  w[2] = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+  w[3] = 0.5 * (t3 - t2);
+  dw[0] = 0.5 * (-3.0 * t2 + 4.0 * t - 1.0);
+  dw[1] = 0.5 * (9.0 * t2 - 10.0 * t);
+  dw[2] = 0.5 * (-9.0 * t2 + 8.0 * t + 1.0);
+  dw[3] = 0.5 * (3.0 * t2 - 2.0 * t);
+}
+
+}  // namespace
+
+double LevelSet::smooth_signed_distance_and_gradient(const Vector3d& p, Vector3d& gradient) const {
+  const openvdb::FloatGrid& grid = *m_impl->grid;
+  UnsafeAccessor accessor(grid.tree());
+  const openvdb::Vec3d x = grid.transform().worldToIndex(openvdb::Vec3d(p(0), p(1), p(2)));
+  const openvdb::Coord base(static_cast<int>(std::floor(x[0])), static_cast<int>(std::floor(x[1])),
+                            static_cast<int>(std::floor(x[2])));
+  double w[3][4], dw[3][4];
+  for (int a = 0; a < 3; ++a)
+    catmull_rom_weights(x[a] - base[a], w[a], dw[a]);
+  double phi = 0.0;
+  Vector3d d_index = Vector3d::Zero();
+  for (int i = 0; i < 4; ++i) {
+    double plane = 0.0, plane_dy = 0.0, plane_dz = 0.0;
+    for (int j = 0; j < 4; ++j) {
+      double row = 0.0, row_dz = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const double v = accessor.getValue(base.offsetBy(i - 1, j - 1, k - 1));
+        row += w[2][k] * v;
+        row_dz += dw[2][k] * v;
+      }
+      plane += w[1][j] * row;
+      plane_dy += dw[1][j] * row;
+      plane_dz += w[1][j] * row_dz;
+    }
+    phi += w[0][i] * plane;
+    d_index(0) += dw[0][i] * plane;
+    d_index(1) += w[0][i] * plane_dy;
+    d_index(2) += w[0][i] * plane_dz;
+  }
+  gradient = d_index / voxel_size();
+  return phi;
+}
+
 double LevelSet::signed_distance(const Vector3d& p) const {
   Vector3d gradient;
   return signed_distance_and_gradient(p, gradient);

@@ -81,6 +81,74 @@ TEST(LevelSet, GradientIsTheUnitNormalAndMatchesFiniteDifferences) {
   EXPECT_LT(worst_normal, std::sqrt(3.0) * kVoxel / (kRadius - 2 * kVoxel * 2.3));
 }
 
+TEST(LevelSet, SmoothGradientIsContinuousAcrossVoxelFaces) {
+  // A band of 6 voxels: the 4³ stencil (up to 2√3·h from a point) stays on narrow-band values
+  // for |d| ≤ (6 − 2√3)·h.
+  const LevelSet sphere = level_set_sphere(kCenter, kRadius, {kVoxel, 6.0});
+  const double band = (6.0 - 2.0 * std::sqrt(3.0)) * kVoxel;
+  const double step = 1e-7 * kVoxel;
+  double worst_smooth_jump = 0.0, worst_trilinear_jump = 0.0, worst_fd = 0.0;
+  double worst_value = 0.0, worst_normal = 0.0;
+  int axis = 0;
+  for (Vector3d p : points_near_sphere(300, band, 5)) {
+    // On a voxel face (cell boundary of both interpolants) across axis a.
+    const int a = axis++ % 3;
+    p(a) = std::round(p(a) / kVoxel) * kVoxel;
+    const Vector3d e = step * Vector3d::Unit(a);
+    Vector3d below, above, at, trilinear_below, trilinear_above;
+    const double value = sphere.smooth_signed_distance_and_gradient(p, at);
+    sphere.smooth_signed_distance_and_gradient(p - e, below);
+    sphere.smooth_signed_distance_and_gradient(p + e, above);
+    sphere.signed_distance_and_gradient(p - e, trilinear_below);
+    sphere.signed_distance_and_gradient(p + e, trilinear_above);
+    worst_smooth_jump = std::max(worst_smooth_jump, (above - below).norm());
+    worst_trilinear_jump =
+        std::max(worst_trilinear_jump, (trilinear_above - trilinear_below).norm());
+    // The gradient is the derivative of the value, also across the face.
+    Vector3d dummy;
+    const double fd = (sphere.smooth_signed_distance_and_gradient(p + e, dummy) -
+                       sphere.smooth_signed_distance_and_gradient(p - e, dummy)) /
+                      (2 * step);
+    worst_fd = std::max(worst_fd, std::abs(fd - at(a)));
+    worst_value = std::max(worst_value, std::abs(value - ((p - kCenter).norm() - kRadius)));
+    worst_normal = std::max(worst_normal, (at - (p - kCenter).normalized()).norm());
+  }
+  // The trilinear gradient jumps at these faces (so the points do lie on them); the tricubic
+  // one does not, beyond the change of a smooth field over 2·step.
+  EXPECT_GT(worst_trilinear_jump, 1e-3);
+  EXPECT_LT(worst_smooth_jump, 1e-5);
+  // Central differences of float voxel values over 2e-7·h resolve the slope to about 1e-5.
+  EXPECT_LT(worst_fd, 1e-4);
+  // At least as accurate as the trilinear interpolant (its bound 3h²/(8ρ)), and its gradient
+  // closer to the unit normal than the trilinear one's √3·h/ρ.
+  const double rho = kRadius - band - 2.0 * std::sqrt(3.0) * kVoxel;
+  EXPECT_LT(worst_value, 3.0 * kVoxel * kVoxel / (8.0 * rho));
+  EXPECT_LT(worst_normal, std::sqrt(3.0) * kVoxel / rho);
+}
+
+TEST(LevelSet, SmoothSamplingReproducesALinearFieldAndTheVoxelValues) {
+  const Vector3d normal = Vector3d(1.0, -2.0, 0.5).normalized();
+  const Vector3d point(0.013, -0.021, 0.007);
+  const auto plane = [&](const Vector3d& p) { return normal.dot(p - point); };
+  const LevelSet level_set = level_set_from_function(
+      plane, Vector3d(-0.3, -0.3, -0.3), Vector3d(0.3, 0.3, 0.3), {kVoxel, 6.0}, "plane");
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coordinate(-0.1, 0.1), offset(-2.0, 2.0);
+  for (int i = 0; i < 200; ++i) {
+    Vector3d p(coordinate(rng), coordinate(rng), coordinate(rng));
+    p += (offset(rng) * kVoxel - plane(p)) * normal;  // within two voxels of the plane
+    Vector3d gradient;
+    const double value = level_set.smooth_signed_distance_and_gradient(p, gradient);
+    // Float voxel values: exact to single precision.
+    EXPECT_NEAR(value, plane(p), 1e-7);
+    EXPECT_LT((gradient - normal).norm(), 1e-5);
+    // At a voxel centre the interpolant is the voxel's value, as the trilinear one is.
+    const Vector3d centre = (p / kVoxel).array().round().matrix() * kVoxel;
+    EXPECT_NEAR(level_set.smooth_signed_distance_and_gradient(centre, gradient),
+                level_set.signed_distance(centre), 1e-9);
+  }
+}
+
 TEST(LevelSet, CsgOfTwoSpheres) {
   const LevelSetOptions options{kVoxel, 3.0};
   const Vector3d ca(0, 0, 0), cb(0.6, 0, 0);

@@ -59,6 +59,9 @@ std::vector<Obstacle> build_obstacles(const Scene& scene, double mean_edge) {
     Obstacle obstacle;
     LevelSetOptions options;
     options.voxel_size = spec.voxel_size > 0.0 ? spec.voxel_size : 0.5 * mean_edge;
+    // Contact samples the tricubic interpolant, whose stencil reaches 2√3 voxels from a point:
+    // a band of 4 voxels keeps it on the voxel values within half a voxel of the surface.
+    options.half_width = 4.0;
     if (spec.plane_point) {
       obstacle = plane_obstacle(spec.name, *spec.plane_point, *spec.plane_normal);
     } else if (spec.implicit) {

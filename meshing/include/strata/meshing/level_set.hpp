@@ -44,6 +44,13 @@ class LevelSet {
   Vector3d gradient(const Vector3d& p) const;
   /// φ and ∇φ in one lookup.
   double signed_distance_and_gradient(const Vector3d& p, Vector3d& gradient) const;
+  /// φ(p) and its gradient from the tricubic Catmull-Rom interpolant of the 4 × 4 × 4 voxels
+  /// around p: it passes through the voxel values, reproduces quadratic fields, and is C¹ — its
+  /// gradient is continuous across voxel faces, where the trilinear one jumps. Energies built on
+  /// it (obstacle contact) are then C¹ too, so Newton can reach a zero gradient where a
+  /// minimiser lies on a voxel face. Exact to the voxel values within half_width − 2√3 voxels of
+  /// the surface (the stencil reads up to 2√3 voxels away; farther it meets the background).
+  double smooth_signed_distance_and_gradient(const Vector3d& p, Vector3d& gradient) const;
 
   /// World-space box (min, max) [m] of the active (narrow-band) voxels; (0, 0) when empty.
   std::pair<Vector3d, Vector3d> bounding_box() const;

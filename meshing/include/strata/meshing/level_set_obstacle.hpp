@@ -1,7 +1,8 @@
 #pragma once
 /// \file level_set_obstacle.hpp
-/// A rigid obstacle (core's obstacle.hpp) whose signed distance is a level set: trilinear φ and
-/// its gradient, +background (no contact) outside the narrow band.
+/// A rigid obstacle (core's obstacle.hpp) whose signed distance is a level set: the C¹ tricubic
+/// φ and its gradient (LevelSet::smooth_signed_distance_and_gradient), +background (no contact)
+/// outside the narrow band.
 #include <memory>
 #include <string>
 
