@@ -459,6 +459,9 @@ void AdaptiveSimulation::advance() {
       move_to_window(w, false);
     }
   }
+  // Static runs merge after an accepted load step, on its equilibrium, before the next one is
+  // solved (whose solve then starts on the merged cut): a merge costs no solve of its own.
+  if (adapting() && is_static(m_solver) && step_count() > 0) adapt(0, false, true);
   const auto start = Clock::now();
   m_estimate_valid = false;
   // With obstacles, friction in a re-solve measures slip from the start of the load step (carried
@@ -468,8 +471,8 @@ void AdaptiveSimulation::advance() {
   m_simulation->advance();
   m_stepping_seconds += seconds_since(start);
   if (adapting() && is_static(m_solver)) {
-    // Solve–mark–refine: re-solve the same load factor on each new cut.
-    for (int pass = 0; pass < m_settings.max_passes && adapting() && adapt(pass, true, true);
+    // Solve–mark–refine: re-solve the same load factor on each refined cut.
+    for (int pass = 0; pass < m_settings.max_passes && adapting() && adapt(pass, true, false);
          ++pass) {
       const auto solve_start = Clock::now();
       m_simulation->resolve_static(
@@ -554,10 +557,12 @@ VectorXd AdaptiveSimulation::criteria_loads(const Simulation& simulation) {
 }
 
 bool AdaptiveSimulation::load_grows_before_next_decision() const {
-  if (is_static(m_solver)) return false;
-  // A merge made now stands until the next coarsening decision, adapt_every steps on.
+  // A merge made now stands until the next coarsening decision: adapt_every steps on (dynamic);
+  // through the next load step, whose solve starts on the merged cut (static: t is the load
+  // factor).
   const double t = time();
-  const double horizon = m_settings.adapt_every * m_solver.dt;
+  const double horizon = is_static(m_solver) ? 1.0 / static_cast<double>(m_solver.load_steps)
+                                             : m_settings.adapt_every * m_solver.dt;
   // A plateau's interpolated values differ from the table's in the last bits: growth is a rise
   // beyond round-off of the load's peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads)

@@ -382,6 +382,52 @@ TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
   EXPECT_GT(merges_at_step_10({{0.0, 0.0}, {0.01, 0.7}, {0.5, 0.7}, {0.6, 0.0}}), 0);
 }
 
+TEST(AdaptiveTolerance, StaticRunsMergeBetweenLoadStepsAndNotWhileALoadStillGrows) {
+  // The slab of the test above over 40 static load steps: the left patch load holds until
+  // λ = 0.2 and is gone at 0.3; the right one is idle until 0.25 and then grows, either to the end
+  // (no merge may be made: at every decision it grows within the next load step) or until 0.35
+  // and then holds (merges may follow from the decision at λ = 0.35 on, whose next load step no
+  // longer raises it). Merges are made after a load step, on its equilibrium, and refine nothing;
+  // the load step's own passes only refine.
+  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(0.6, 0.3, 0.1), {4, 2, 1});
+  Material material = rubber();
+  material.youngs_modulus = 1e5;
+  material.poisson_ratio = 0.35;
+  SolverSettings solver;
+  solver.mode = SimulationMode::static_equilibrium;
+  solver.load_steps = 40;
+  const auto run = [&](const std::vector<std::array<double, 2>>& right_amplitude) {
+    RegionLoad left =
+        box_load(Vector3d(0.06, 0.12, 0.1), Vector3d(0.12, 0.18, 0.1), Vector3d(0, 0, -40.0));
+    left.amplitude.points = {{0.0, 1.0}, {0.2, 1.0}, {0.3, 0.0}};
+    RegionLoad right =
+        box_load(Vector3d(0.48, 0.12, 0.1), Vector3d(0.54, 0.18, 0.1), Vector3d(0, 0, -40.0));
+    right.name = "forces.1";
+    right.amplitude.points = right_amplitude;
+    AdaptiveSimulation sim(coarse, defaults(2), material,
+                           {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
+                           {left, right}, std::nullopt, Vector3d::Zero(), solver);
+    while (!sim.finished())
+      sim.advance();
+    return sim.changes();
+  };
+  Index grows_to_the_end = 0;
+  for (const CutChangeRecord& change : run({{0.0, 0.0}, {0.25, 0.0}, {1.0, 1.0}}))
+    grows_to_the_end += change.coarsened;
+  EXPECT_EQ(grows_to_the_end, 0);
+  Index merged = 0, refined = 0;
+  for (const CutChangeRecord& change : run({{0.0, 0.0}, {0.25, 0.0}, {0.35, 1.0}, {1.0, 1.0}})) {
+    refined += change.refined;
+    if (change.coarsened == 0) continue;
+    merged += change.coarsened;
+    EXPECT_EQ(change.refined, 0) << "a merge decision at load step " << change.step;
+    EXPECT_EQ(change.pass, 0);
+    EXPECT_GE(change.step, 14) << "a merge while the right load grows";
+  }
+  EXPECT_GT(refined, 0);
+  EXPECT_GT(merged, 0);
+}
+
 /// Values outside (0, 1] set by `set` are refused with an error naming hierarchy.`key`.
 void expect_fraction_refused(const std::string& key,
                              const std::function<void(HierarchySettings&, double)>& set) {

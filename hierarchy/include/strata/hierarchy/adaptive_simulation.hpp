@@ -134,7 +134,9 @@ struct CutChangePhases {
 };
 
 struct CutChangeRecord {
-  long step = 0;                          ///< after this step (static: load step) …
+  /// After this step (static: load step; a static run's merges are made after a load step, on
+  /// its equilibrium, before the next one is solved) …
+  long step = 0;
   int pass = 0;                           ///< … and this pass (static; 0 in dynamic runs)
   double time = 0.0;                      ///< simulated time or load factor
   Index refined = 0;                      ///< nodes refined (including 2:1 balance)
@@ -352,8 +354,9 @@ class AdaptiveSimulation final : public SimulationRun {
   /// step (mesh positions of the current cut, carried with each change), from which friction in
   /// a re-solve measures slip; empty otherwise.
   VectorXd m_load_step_start;
-  /// Dynamic runs: whether a load with an amplitude grows (its largest magnitude over the next
-  /// adapt_every steps exceeds its magnitude now) before the next coarsening decision.
+  /// Whether a load with an amplitude grows before the next coarsening decision: its largest
+  /// magnitude over the next adapt_every steps (dynamic) or the next load step (static) exceeds
+  /// its magnitude now.
   bool load_grows_before_next_decision() const;
   std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
   /// Loads with an amplitude, each on the finest level.
