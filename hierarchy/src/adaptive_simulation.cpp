@@ -732,13 +732,44 @@ bool AdaptiveSimulation::adapting() const {
 
 bool AdaptiveSimulation::past_full_resolution_fraction() const {
   if (m_settings.mode != HierarchyMode::adaptive || m_settings.full_resolution_fraction >= 1.0 ||
-      is_explicit(m_solver) || max_refine_level() < m_tree->max_level())
+      max_refine_level() < m_tree->max_level())
     return false;
   const auto finest = static_cast<double>(
       potential_leaf_count(static_cast<std::uint64_t>(m_tree->num_roots()), m_tree->max_level()));
   const Index budget = m_settings.criteria.max_active_elements;
   if (budget > 0 && static_cast<double>(budget) < finest) return false;
-  return static_cast<double>(m_cut->size()) > m_settings.full_resolution_fraction * finest;
+  return static_cast<double>(m_cut->size()) > m_settings.full_resolution_fraction * finest &&
+         (!is_explicit(m_solver) || finest_level_stable());
+}
+
+bool AdaptiveSimulation::finest_level_stable() const {
+  if (!m_finest_level_stable) {
+    // The bound is the largest over the tets (stable_time_step.hpp): the finest tets of each
+    // root as a mesh of their own.
+    bool stable = true;
+    std::vector<Matrix3x4d> tets, children;
+    for (NodeId root = 0; root < m_tree->num_roots() && stable; ++root) {
+      tets.assign(1, m_tree->bey_positions(root));
+      for (int level = 0; level < m_tree->max_level(); ++level) {
+        children.clear();
+        for (const Matrix3x4d& x : tets)
+          for (const Matrix3x4d& child : red_refine_tet(x))
+            children.push_back(child);
+        tets.swap(children);
+      }
+      MatrixX3d vertices(4 * static_cast<Index>(tets.size()), 3);
+      MatrixX4i elements(static_cast<Index>(tets.size()), 4);
+      for (Index t = 0; t < elements.rows(); ++t)
+        for (int c = 0; c < 4; ++c) {
+          vertices.row(4 * t + c) = tets[t].col(c).transpose();
+          elements(t, c) = static_cast<int>(4 * t + c);
+        }
+      stable = stable_time_step_estimate(vertices, elements, m_material, m_solver.integrator) >=
+               m_solver.dt;
+    }
+    m_finest_level_stable = stable;
+  }
+  return *m_finest_level_stable;
 }
 
 Index AdaptiveSimulation::edit_to_full_resolution() {

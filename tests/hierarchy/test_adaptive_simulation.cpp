@@ -324,6 +324,43 @@ TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
   EXPECT_GT(fine.cut().finest_level(), 0);
 }
 
+TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevelIsStable) {
+  // Any refinement takes the slab's cut past a fraction of 0.02 of the finest level.
+  const PressedSlab slab;
+  SolverSettings settings;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.dt = 1.0;
+  settings.duration = 1.0;
+  HierarchySettings full = hierarchy(2, HierarchyMode::full);
+  const double finest_dt = AdaptiveSimulation(slab.coarse, full, rubber(), slab.fixed, slab.loads,
+                                              std::nullopt, Vector3d::Zero(), settings)
+                               .simulation()
+                               .stable_dt_estimate();
+  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
+  h.adapt_every = 1;
+  h.criteria.min_steps_between_changes = 0;
+  h.full_resolution_fraction = 0.02;
+  const auto run_at = [&](double dt) {
+    settings.dt = dt;
+    settings.duration = 20 * dt;
+    auto sim = std::make_unique<AdaptiveSimulation>(
+        slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt, Vector3d::Zero(), settings);
+    run(*sim);
+    return sim;
+  };
+  // Within the finest level's stable step: the first refinement goes on at full resolution.
+  const auto stable = run_at(0.5 * finest_dt);
+  EXPECT_GE(stable->tolerance_report().full_resolution_step, 0);
+  EXPECT_EQ(stable->cut().size(), slab.coarse.tets.rows() * 64);
+  // Beyond it (within level 1's, about twice as long): refined only where the children stay
+  // stable, and never at full resolution.
+  const auto unstable = run_at(1.3 * finest_dt);
+  EXPECT_EQ(unstable->tolerance_report().full_resolution_step, -1);
+  EXPECT_GE(unstable->cut().finest_level(), 1);
+  EXPECT_LT(unstable->cut().size(), slab.coarse.tets.rows() * 64);
+  EXPECT_GT(unstable->tolerance_report().refused_refinements, 0);
+}
+
 TEST(AdaptiveSimulation, RejectsBadSettings) {
   const Bar bar;
   HierarchySettings h = hierarchy(2, HierarchyMode::uniform, 3);

@@ -94,8 +94,8 @@ struct HierarchySettings {
   /// finest level's tets, the run continues at full resolution (every node at the deepest level,
   /// no more estimates or cut changes): a cut that large costs more than full resolution (hanging
   /// vertices, estimates, redone steps and cut changes; README, "Error control"). 1: never.
-  /// Not with explicit integrators, an element budget below the finest level, or max_level below
-  /// the tree's depth.
+  /// Not with an element budget below the finest level, max_level below the tree's depth, or an
+  /// explicit integrator whose dt exceeds the finest level's stable-step estimate.
   double full_resolution_fraction = 0.75;
   /// With the recovery estimate (an error-estimating indicator): the merges of one change are
   /// kept to those whose predicted estimate stays within coarsen_budget · tolerance
@@ -299,6 +299,10 @@ class AdaptiveSimulation final : public SimulationRun {
   RecoveryEstimate estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
+  /// Explicit integrators: whether solver.dt is within the stable-step estimate of the tree's
+  /// finest level (computed once), so that the run may go on at full resolution.
+  bool finest_level_stable() const;
+  mutable std::optional<bool> m_finest_level_stable;
   /// A cut change threw: the run cannot go on (the Simulation, if any, is the previous cut's,
   /// rebuilt at the state the change was moving).
   bool m_failed = false;
