@@ -201,6 +201,32 @@ TEST(CliHierarchy, UnmetToleranceWarnsAndIsReported) {
   EXPECT_EQ(free_stats["hierarchy"]["coarsen_budget"], 0.8);  // the default
 }
 
+TEST(CliHierarchy, ARunThatStopsEarlyDoesNotClaimItsToleranceAndLocatesTheElement) {
+  // A St. Venant–Kirchhoff block punched 15 cm deep: an element inverts at the fourth load step.
+  // The element is numbered in the cut; the message also says where it is at rest.
+  const TempFolder folder;
+  const json scene = json::parse(R"({
+    "mesh": {"box": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.2], "cells": [3, 3, 2]}},
+    "material": {"model": "stvk", "youngs_modulus": 1e6, "poisson_ratio": 0.35, "density": 1000},
+    "fixed": [{"plane": {"point": [0, 0, 0], "normal": [0, 0, 1]}}],
+    "prescribed": [{"region": {"box": {"min": [0.1, 0.1, 0.2], "max": [0.3, 0.3, 0.2]}},
+                    "displacement": [0, 0, -0.15]}],
+    "solver": {"mode": "static", "load_steps": 10},
+    "output": {"probes": [[0.2, 0.2, 0.2]]},
+    "hierarchy": {"levels": 1}
+  })");
+  write_text(folder.path() / "punch.json", scene.dump(2));
+  const CliResult result = run_strata("run punch.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 3) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("inverted"));
+  EXPECT_THAT(result.err, ::testing::ContainsRegex("element [0-9]+ \\(at rest \\([-0-9.e]+, "
+                                                   "[-0-9.e]+, [-0-9.e]+\\) m\\) inverted"));
+  const json stats = read_json(folder.path() / "out" / "punch" / "stats.json");
+  EXPECT_EQ(stats["status"], "diverged");
+  EXPECT_EQ(stats["hierarchy"]["steps_over_tolerance"], 0);
+  EXPECT_FALSE(stats["hierarchy"]["tolerance_met"].get<bool>());
+}
+
 TEST(CliHierarchy, BadToleranceNamesTheKey) {
   const TempFolder folder;
   json scene = slab_scene("adaptive");

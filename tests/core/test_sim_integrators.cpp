@@ -7,8 +7,10 @@
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/common/parallel.hpp"
+#include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/fem/lumped_mass.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/divergence_check.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
 
@@ -239,6 +241,48 @@ TEST(SimIntegrators, Rk4BeyondTheStabilityLimitIsDetected) {
   const long diverged_at = diverged_step(beam);
   EXPECT_GT(diverged_at, 0);
   EXPECT_LT(diverged_at, 20);  // of 55 steps
+}
+
+TEST(SimIntegrators, DivergenceNamesTheVertexOrElementAndWhereItIsAtRest) {
+  // The six tets of a unit cube: moving its corner (1, 1, 1) through the cube to (−1, −1, −1)
+  // inverts tets around it (StVK checks inversion), and a far move trips the blow-up limit. Each
+  // message gives the index and the rest position (an element's: its centroid).
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 1, 1), {1, 1, 1});
+  Material material;
+  material.model = MaterialModel::stvk;
+  const ElasticModel model(mesh.vertices, mesh.tets, material);
+  const DivergenceLimits limits = default_divergence_limits(material, std::sqrt(3.0));
+  VectorXd x = model.rest_positions();
+  const Index corner = mesh.vertices.rows() - 1;  // (1, 1, 1)
+  ASSERT_EQ(mesh.vertices.row(corner), Eigen::RowVector3d(1, 1, 1));
+  const auto message = [&] {
+    try {
+      check_divergence(model, x, VectorXd(), limits, 3, 0.3, "static");
+    } catch (const DivergenceError& error) {
+      EXPECT_EQ(error.step(), 3);
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(), "");
+  x.segment<3>(3 * corner) = Vector3d(-1, -1, -1);
+  const std::string inverted = message();
+  const auto [j, tet] = model.min_volume_ratio(x);
+  ASSERT_LE(j, 0.0);
+  Vector3d centroid = Vector3d::Zero();
+  for (int k = 0; k < 4; ++k)
+    centroid += 0.25 * mesh.vertices.row(mesh.tets(tet, k)).transpose();
+  char expected[160];
+  std::snprintf(expected, sizeof(expected),
+                "static: step 3, t = 0.300000: element %d (at rest (%.4g, %.4g, %.4g) m) inverted",
+                static_cast<int>(tet), centroid.x(), centroid.y(), centroid.z());
+  EXPECT_EQ(inverted.rfind(expected, 0), 0u) << inverted;
+  x.segment<3>(3 * corner) = Vector3d(1e3, 1, 1);
+  EXPECT_EQ(message().rfind("static: step 3, t = 0.300000: vertex " + std::to_string(corner) +
+                                " (at rest (1, 1, 1) m) displaced beyond the blow-up limit",
+                            0),
+            0u)
+      << message();
 }
 
 TEST(SimIntegrators, BackwardEulerIsStableFarBeyondTheExplicitLimit) {

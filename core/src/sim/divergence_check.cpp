@@ -4,6 +4,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 
 #include "strata/core/common/error.hpp"
@@ -18,6 +19,18 @@ DivergenceLimits default_divergence_limits(const Material& material, double diag
   return limits;
 }
 
+namespace {
+
+/// " (at rest (x, y, z) m)": where a vertex or element is, whatever its numbering (a hierarchy
+/// numbers the tets and vertices of its current cut).
+std::string rest_location(const Vector3d& p) {
+  char buffer[96];
+  std::snprintf(buffer, sizeof(buffer), " (at rest (%.4g, %.4g, %.4g) m)", p.x(), p.y(), p.z());
+  return buffer;
+}
+
+}  // namespace
+
 void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<VectorXd> v,
                       const DivergenceLimits& limits, long step, double time,
                       const std::string& context, const std::pair<double, Index>* volume_ratio) {
@@ -25,6 +38,9 @@ void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<
       context + ": step " + std::to_string(step) + ", t = " + std::to_string(time) + ": ";
   auto fail = [&](const std::string& what) { throw DivergenceError(where + what, step, time); };
   const VectorXd& rest = model.rest_positions();
+  const auto vertex = [&](Index i) {
+    return "vertex " + std::to_string(i) + rest_location(rest.segment<3>(3 * i));
+  };
   const Index num_vertices = x.size() / 3;
   const bool has_v = v.size() > 0;
   auto vertex_fails = [&](Index i) {
@@ -45,19 +61,24 @@ void check_divergence(const ElasticModel& model, ConstRef<VectorXd> x, ConstRef<
   if (first < num_vertices) {
     const Index i = first;
     if (!x.segment<3>(3 * i).allFinite() || (has_v && !v.segment<3>(3 * i).allFinite()))
-      fail("non-finite position or velocity at vertex " + std::to_string(i));
+      fail("non-finite position or velocity at " + vertex(i));
     if (has_v && v.segment<3>(3 * i).norm() > limits.max_speed)
-      fail("vertex " + std::to_string(i) + " moves at " +
-           std::to_string(v.segment<3>(3 * i).norm()) + " m/s, above the blow-up limit " +
-           std::to_string(limits.max_speed) + " m/s (10 x P-wave speed); reduce dt");
-    fail("vertex " + std::to_string(i) + " displaced beyond the blow-up limit " +
+      fail(vertex(i) + " moves at " + std::to_string(v.segment<3>(3 * i).norm()) +
+           " m/s, above the blow-up limit " + std::to_string(limits.max_speed) +
+           " m/s (10 x P-wave speed); reduce dt");
+    fail(vertex(i) + " displaced beyond the blow-up limit " +
          std::to_string(limits.max_displacement) + " m (100 x bounding-box diagonal)");
   }
   if (limits.check_inversion) {
     const auto [min_j, tet] = volume_ratio != nullptr ? *volume_ratio : model.min_volume_ratio(x);
-    if (!(min_j > 0.0))
-      fail("element " + std::to_string(tet) + " inverted (J = " + std::to_string(min_j) + ") and " +
+    if (!(min_j > 0.0)) {
+      Vector3d centroid = Vector3d::Zero();
+      for (int k = 0; k < 4; ++k)
+        centroid += 0.25 * rest.segment<3>(3 * model.tets()(tet, k));
+      fail("element " + std::to_string(tet) + rest_location(centroid) +
+           " inverted (J = " + std::to_string(min_j) + ") and " +
            to_string(model.material().model) + " cannot handle inversion");
+    }
   }
 }
 

@@ -150,7 +150,7 @@ class SceneSimulation {
 };
 
 /// stats.json's "hierarchy" block: settings, the active-cut history and every cut change.
-nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
+nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished) {
   const HierarchySettings& settings = adaptive.settings();
   nlohmann::json block;
   block["mode"] = to_string(settings.mode);
@@ -222,7 +222,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive) {
   const ToleranceReport& report = adaptive.tolerance_report();
   block["tolerance"] = report.tolerance;
   block["estimated_error"] = report.max_estimated_error;
-  block["tolerance_met"] = report.steps_over_tolerance == 0;
+  // A run that stopped early met nothing to its end.
+  block["tolerance_met"] = finished && report.steps_over_tolerance == 0;
   block["steps_over_tolerance"] = report.steps_over_tolerance;
   block["refused_refinements"] = report.refused_refinements;
   block["redone_steps"] = report.redone_steps;
@@ -372,7 +373,7 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   stats["frames"] = summary.frames;
   stats["probes"] = scene.output.probes.size();
   if (scene_simulation.adaptive())
-    stats["hierarchy"] = hierarchy_json(*scene_simulation.adaptive());
+    stats["hierarchy"] = hierarchy_json(*scene_simulation.adaptive(), summary.status == "ok");
   return stats;
 }
 

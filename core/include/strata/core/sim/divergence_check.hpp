@@ -7,7 +7,8 @@
 ///    this within a few steps) or a displacement from rest above `max_displacement` (default 100 ×
 ///    the bounding-box diagonal);
 /// 3. an inverted element (J = det F ≤ 0) when the material cannot handle inversion (StVK).
-/// A violation throws DivergenceError naming the step, the time and the vertex or element.
+/// A violation throws DivergenceError naming the step, the time and the vertex or element, with
+/// its rest position (an element's: its centroid).
 #include "strata/core/common/types.hpp"
 #include "strata/core/fem/elastic_model.hpp"
 
