@@ -93,6 +93,8 @@ def main():
         full_frames = run(args, "full", {"mode": "full"}, frames=True)[1]
     reference = read_probes(full_folder)
     scale = max(sum(c * c for c in u) ** 0.5 for u in reference.values())
+    if scale == 0.0:
+        sys.exit("compare_to_full: the full run's probes do not move (no error to measure)")
     report = {"scene": args.scene, "full": {"wall_seconds": full_stats["wall_seconds"],
                                             "tets": full_stats["tets"]}, "runs": []}
     print(f"full: {full_stats['tets']} tets, {full_stats['wall_seconds']:.2f} s, "

@@ -210,8 +210,9 @@ AdaptiveSimulation::AdaptiveSimulation(
           computed = recovery_error_estimate(state);
           estimate = &computed;
         }
-        return merges_within_budget(state, *estimate, parents,
-                                    m_settings.coarsen_budget * m_settings.tolerance)
+        return merges_within_budget(
+                   state, *estimate, parents,
+                   m_settings.coarsen_budget * m_settings.tolerance / state.tolerance_scale)
             .kept;
       });
   std::vector<RegionLoad> constant_loads;
@@ -475,11 +476,14 @@ void AdaptiveSimulation::advance() {
     for (int pass = 0; pass < m_settings.max_passes && adapting() && adapt(pass, true, false);
          ++pass) {
       const auto solve_start = Clock::now();
+      const double refined_estimate = m_estimate.relative_error;  // of the cut before the pass
+      const VectorXd carried = m_simulation->positions();
       m_simulation->resolve_static(
           m_load_step_start.size() > 0
               ? m_constrained->constraints.restrict_to_free(m_load_step_start)
               : VectorXd());
       m_stepping_seconds += seconds_since(solve_start);
+      if (m_estimates_error) measure_estimate(refined_estimate, carried);
     }
   }
   m_load_step_start.resize(0);
@@ -582,12 +586,13 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   CutState state{*m_tree,           flat,       sim.positions(),  fields,          loads,
                  sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
   state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
+  state.tolerance_scale = m_estimate_scale;
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
   state.recovery_estimate = &m_estimate;
   // An error-estimating indicator refines only while the run's estimate exceeds the tolerance.
   const bool within_tolerance =
-      m_estimates_error && m_estimate.relative_error <= m_settings.tolerance;
+      m_estimates_error && m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
   if (!coarsen && (!refine || within_tolerance)) return {};
   fields = sim.model().tet_fields(sim.positions());
   // No merges while a load with an amplitude is still growing: the estimate of the current state
@@ -881,7 +886,7 @@ void AdaptiveSimulation::record_sample() {
   if (m_settings.mode != HierarchyMode::full &&
       !m_at_full_resolution) {  // full resolution: zero by definition
     const RecoveryEstimate estimate = estimate_error();
-    sample.estimated_error = estimate.relative_error;
+    sample.estimated_error = m_estimate_scale * estimate.relative_error;
     sample.estimated_energy_error = estimate.relative_energy_error;
     sample.estimated_upper_error = estimate.upper_error;
     sample.estimated_load_work_error = estimate.load_work_error;
@@ -891,6 +896,23 @@ void AdaptiveSimulation::record_sample() {
     if (sample.estimated_error > m_settings.tolerance) ++m_report.steps_over_tolerance;
   }
   m_history.push_back(sample);
+}
+
+void AdaptiveSimulation::measure_estimate(double refined_estimate, const VectorXd& carried) {
+  // The pass carried the previous cut's equilibrium to the refined cut (the same field) and
+  // solved again: the largest vertex displacement it changed, relative to the largest
+  // displacement, is a lower bound of the previous cut's error in the measure of the tolerance.
+  const VectorXd& solved = m_simulation->positions();
+  const MatrixX3d& rest = m_constrained->flat.mesh.vertices;
+  double largest = 0.0, change = 0.0;
+  for (Index v = 0; v < rest.rows(); ++v) {
+    largest = std::max(largest, (solved.segment<3>(3 * v) - rest.row(v).transpose()).norm());
+    change = std::max(change, (solved.segment<3>(3 * v) - carried.segment<3>(3 * v)).norm());
+  }
+  if (!(largest > 0.0) || !(refined_estimate > 0.0)) return;
+  // The latest measurement, on the finest cut so far, stands.
+  m_estimate_scale = std::max(1.0, change / largest / refined_estimate);
+  m_report.estimate_scale = std::max(m_report.estimate_scale, m_estimate_scale);
 }
 
 VectorXi AdaptiveSimulation::cell_levels() const {

@@ -171,8 +171,9 @@ void RecoveryIndicator::evaluate(const CutState& state, VectorXd& eta) const {
   const Index n = estimate.element_error_sq.size();
   eta.setZero(n);
   if (estimate.reference_energy_sq <= 0.0 || n == 0) return;
+  const double tolerance = m_tolerance / state.tolerance_scale;
   const double energy_tolerance =
-      upper_tolerance(estimate, m_tolerance) / kDisplacementPerEnergyError;
+      upper_tolerance(estimate, tolerance) / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   eta = (estimate.element_error_sq / share).cwiseSqrt();
 }
@@ -191,7 +192,8 @@ double RecoveryIndicator::merge_indicator(const CutState& state, const std::arra
   // A merge raises c, which τ_z (from this state's c) does not see; on the finest level c = 0
   // and τ_z = ∞. The merge is judged against the smaller of τ_z and τ, never more loosely than
   // the upper estimate alone would allow.
-  const double merge_tolerance = std::min(m_tolerance, upper_tolerance(estimate, m_tolerance));
+  const double tolerance = m_tolerance / state.tolerance_scale;
+  const double merge_tolerance = std::min(tolerance, upper_tolerance(estimate, tolerance));
   const double energy_tolerance = merge_tolerance / kDisplacementPerEnergyError;
   const double share = energy_tolerance * energy_tolerance * estimate.reference_energy_sq / n;
   return std::sqrt(loss * removed * removed / share);

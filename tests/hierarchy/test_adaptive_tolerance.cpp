@@ -383,7 +383,7 @@ TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
 }
 
 TEST(AdaptiveTolerance, StaticRunsMergeBetweenLoadStepsAndNotWhileALoadStillGrows) {
-  // The slab of the test above over 40 static load steps: the left patch load holds until
+  // The slab of the test above over 40 static load steps (τ = 5 %): the left patch load holds until
   // λ = 0.2 and is gone at 0.3; the right one is idle until 0.25 and then grows, either to the end
   // (no merge may be made: at every decision it grows within the next load step) or until 0.35
   // and then holds (merges may follow from the decision at λ = 0.35 on, whose next load step no
@@ -396,6 +396,8 @@ TEST(AdaptiveTolerance, StaticRunsMergeBetweenLoadStepsAndNotWhileALoadStillGrow
   SolverSettings solver;
   solver.mode = SimulationMode::static_equilibrium;
   solver.load_steps = 40;
+  HierarchySettings hierarchy = defaults(2);
+  hierarchy.tolerance = 0.05;
   const auto run = [&](const std::vector<std::array<double, 2>>& right_amplitude) {
     RegionLoad left =
         box_load(Vector3d(0.06, 0.12, 0.1), Vector3d(0.12, 0.18, 0.1), Vector3d(0, 0, -40.0));
@@ -404,7 +406,7 @@ TEST(AdaptiveTolerance, StaticRunsMergeBetweenLoadStepsAndNotWhileALoadStillGrow
         box_load(Vector3d(0.48, 0.12, 0.1), Vector3d(0.54, 0.18, 0.1), Vector3d(0, 0, -40.0));
     right.name = "forces.1";
     right.amplitude.points = right_amplitude;
-    AdaptiveSimulation sim(coarse, defaults(2), material,
+    AdaptiveSimulation sim(coarse, hierarchy, material,
                            {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
                            {left, right}, std::nullopt, Vector3d::Zero(), solver);
     while (!sim.finished())

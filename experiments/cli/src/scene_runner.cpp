@@ -87,7 +87,11 @@ std::vector<Obstacle> build_obstacles(const Scene& scene, double mean_edge) {
 namespace {
 
 std::vector<Obstacle> build_obstacles(const Scene& scene, const TetMesh& mesh) {
-  return detail::build_obstacles(scene, mean_edge_length(mesh.vertices, mesh.tets));
+  // With a hierarchy the finest level's vertices touch the obstacles: its edges, halved per
+  // level, set the default voxel.
+  const int levels = scene.hierarchy ? scene.hierarchy->levels : 0;
+  return detail::build_obstacles(scene,
+                                 std::ldexp(mean_edge_length(mesh.vertices, mesh.tets), -levels));
 }
 
 /// The scene's run (SimulationRun): a plain Simulation on the mesh, or (scene key "hierarchy") an
@@ -225,6 +229,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
   // A run that stopped early met nothing to its end.
   block["tolerance_met"] = finished && report.steps_over_tolerance == 0;
   block["steps_over_tolerance"] = report.steps_over_tolerance;
+  block["estimate_scale"] = report.estimate_scale;
   block["refused_refinements"] = report.refused_refinements;
   block["redone_steps"] = report.redone_steps;
   block["redo_seconds"] = report.redo_seconds;

@@ -193,6 +193,10 @@ struct ToleranceReport {
   /// −1: 0 before the first step; a dynamic run redid step n + 1 at full resolution (n here) or
   /// changed after step n; a static run solved load step n again at full resolution.
   long full_resolution_step = -1;
+  /// Static runs: the largest factor the estimate was scaled by (AdaptiveSimulation: a
+  /// refinement pass that changed the solution more than the estimate of the cut it refined);
+  /// 1 when none did.
+  double estimate_scale = 1.0;
 };
 
 class AdaptiveSimulation final : public SimulationRun {
@@ -299,6 +303,14 @@ class AdaptiveSimulation final : public SimulationRun {
   RecoveryEstimate estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
+  /// Static runs, after a refinement pass re-solved its load step: the pass's change (largest
+  /// vertex displacement difference between the carried state `carried` and the new
+  /// equilibrium, relative to the largest displacement) bounds the refined cut's error from
+  /// below; where it exceeds that cut's estimate `refined_estimate`, their ratio scales the
+  /// estimate of every later decision and sample (m_estimate_scale; the latest measurement
+  /// stands, 1 when it is within the estimate).
+  void measure_estimate(double refined_estimate, const VectorXd& carried);
+  double m_estimate_scale = 1.0;
   /// Explicit integrators: whether solver.dt is within the stable-step estimate of the tree's
   /// finest level (computed once), so that the run may go on at full resolution.
   bool finest_level_stable() const;

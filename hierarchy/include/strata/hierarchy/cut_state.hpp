@@ -50,6 +50,10 @@ struct CutState {
   /// Optional: the recovery estimate of this very state (refinement_recovery_estimator.hpp),
   /// when the driver has computed it already; the recovery indicator then reuses it.
   const RecoveryEstimate* recovery_estimate = nullptr;
+  /// The decision's tolerance is the indicator's divided by this (≥ 1): a static run whose
+  /// refinement passes measured changes larger than the estimate of the cuts they refined judges
+  /// later decisions by that ratio (AdaptiveSimulation, README "Error control").
+  double tolerance_scale = 1.0;
 };
 
 }  // namespace strata
