@@ -1,8 +1,10 @@
 // strata: run scenes, inspect and convert tet meshes. Exit codes: 0 ok, 2 bad input, 3 diverged.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -24,8 +26,30 @@ constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;
 constexpr int kExitDiverged = 3;
 
+/// One line whatever the message holds: control characters (a newline or NUL inside a key, a
+/// value or a file name the message quotes) are written as escapes.
+std::string one_line(const std::string& message) {
+  std::string line;
+  for (const char c : message) {
+    if (c == '\n') {
+      line += "\\n";
+    } else if (c == '\r') {
+      line += "\\r";
+    } else if (c == '\t') {
+      line += "\\t";
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\x%02x", static_cast<unsigned char>(c));
+      line += escaped;
+    } else {
+      line += c;
+    }
+  }
+  return line;
+}
+
 int fail(const std::string& message, int code) {
-  std::cerr << "strata: error: " << message << std::endl;
+  std::cerr << "strata: error: " << one_line(message) << std::endl;
   return code;
 }
 
@@ -214,6 +238,11 @@ int main(int argc, char** argv) {
     return fail(error.what(), kExitBadInput);
   } catch (const std::filesystem::filesystem_error& error) {
     return fail(error.what(), kExitBadInput);
+  } catch (const std::bad_alloc&) {
+    return fail(
+        "out of memory: the scene needs more memory than the machine gives (a finer mesh, more "
+        "hierarchy levels or a smaller voxel_size than it can hold)",
+        kExitBadInput);
   } catch (const std::exception& error) {
     return fail(std::string("internal error: ") + error.what(), 1);
   }

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <gnu/libc-version.h>
 
 #include <cmath>
@@ -315,6 +317,26 @@ TEST(CliEndToEnd, DynamicFreeFallMatchesDiscreteKinematics) {
   }
 }
 
+TEST(CliEndToEnd, AnInterruptedRunLeavesNoStatsFile) {
+  // A previous run's stats.json in the output folder; a long run into the same folder is
+  // stopped with SIGTERM: the folder must not keep a stats.json that claims a finished run.
+  TempFolder folder;
+  json scene = bar_scene();
+  scene["solver"] = json::parse(R"({"mode": "dynamic", "integrator": "implicit_euler", "dt": 1e-4,
+                      "duration": 1000})");
+  write_scene(folder, scene);
+  const std::filesystem::path out = folder.path() / "out" / "scene";
+  std::filesystem::create_directories(out);
+  write_text(out / "stats.json", "{\"status\": \"ok\"}");
+  const std::string command = "cd '" + folder.path().string() + "' && timeout -s TERM 5 '" +
+                              STRATA_CLI_PATH + "' run scene.json -q > /dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 124);                       // stopped by the timeout, not finished
+  EXPECT_TRUE(std::filesystem::exists(out / "probes.csv"));  // the run had started its outputs
+  EXPECT_FALSE(std::filesystem::exists(out / "stats.json"));
+}
+
 TEST(CliEndToEnd, ExplicitRunBeyondStableStepDivergesWithExitCode3) {
   TempFolder folder;
   json scene = bar_scene();
@@ -377,6 +399,39 @@ TEST(CliEndToEnd, BadInputExitsWith2AndOneLineErrors) {
   EXPECT_EQ(result.exit_code, 2);
   result = run_strata("frobnicate", folder.path());
   EXPECT_EQ(result.exit_code, 2);
+}
+
+TEST(CliEndToEnd, OverflowingNumbersAndControlCharactersGiveOneLineBadInputErrors) {
+  TempFolder folder;
+  // A literal beyond a double.
+  write_text(folder.path() / "huge.json",
+             "{\"mesh\": {\"box\": {\"min\": [0, 0, 0], "
+             "\"max\": [1e400, 1, 1], \"cells\": [1, 1, 1]}}}");
+  CliResult result = run_strata("run huge.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(result.err,
+            "strata: error: huge.json: number overflow parsing '1e400' (not a finite double)\n");
+  // Finite values whose products overflow: the weight, or the stiffness.
+  json scene = bar_scene();
+  scene["gravity"] = {0, 0, -1e300};
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("scene.json: loads: the masses or the loads"));
+  scene = bar_scene();
+  scene["material"]["youngs_modulus"] = 1e300;
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("scene.json: material.youngs_modulus: must be at most 1e20"));
+  // A newline inside a value the message quotes stays on the one line, escaped.
+  scene = bar_scene();
+  scene["material"]["model"] = "stvk\nstrata: error: a second line";
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_THAT(result.err, HasSubstr("\"stvk\\nstrata: error: a second line\""));
 }
 
 TEST(CliEndToEnd, BadMeshFileIsNamed) {

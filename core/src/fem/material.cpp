@@ -36,6 +36,10 @@ void validate_material(const Material& material, const std::string& where) {
     throw InputError(where + ".poisson_ratio: must be in [0, 0.5)");
   if (!(material.density > 0.0) || !std::isfinite(material.density))
     throw InputError(where + ".density: must be positive and finite");
+  // Beyond any solid by far; larger values overflow the stiffness and the stable step.
+  if (material.youngs_modulus > 1e20)
+    throw InputError(where + ".youngs_modulus: must be at most 1e20 Pa");
+  if (material.density > 1e10) throw InputError(where + ".density: must be at most 1e10 kg/m^3");
   if (!(material.mass_damping >= 0.0) || !std::isfinite(material.mass_damping))
     throw InputError(where + ".damping.mass: must be >= 0");
   if (!(material.stiffness_damping >= 0.0) || !std::isfinite(material.stiffness_damping))

@@ -92,6 +92,12 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     mesh_external += options.extra_mesh_forces;
   }
   m_external = m_embedded->reduce(mesh_external);
+  // Finite inputs whose products or norms overflow (gravity 1e308 times a mass) would pass
+  // every convergence test at once.
+  if (!m_vertex_mass.allFinite() || !std::isfinite(m_external.squaredNorm()))
+    throw InputError(
+        "loads: the masses or the loads (gravity × mass, region forces) overflow a double; check "
+        "gravity, density and the forces' magnitudes");
   for (TimedForces& timed : options.extra_timed_mesh_forces) {
     validate_amplitude(timed.amplitude, "simulation: extra_timed_mesh_forces");
     if (timed.amplitude.empty() || timed.forces.size() != mesh_external.size() ||

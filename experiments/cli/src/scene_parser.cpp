@@ -358,6 +358,13 @@ nlohmann::json read_json_file(const std::filesystem::path& file) {
     }
     throw InputError(file.string() + ": malformed JSON at byte " + std::to_string(error.byte) +
                      ": " + what);
+  } catch (const nlohmann::json::out_of_range& error) {
+    // "[json.exception.out_of_range.406] number overflow parsing '1e400'"
+    const std::string what = error.what();
+    const std::size_t start = what.find("] ");
+    throw InputError(file.string() + ": " +
+                     (start == std::string::npos ? what : what.substr(start + 2)) +
+                     " (not a finite double)");
   }
 }
 

@@ -463,6 +463,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   log.flush();
 
   std::filesystem::create_directories(summary.output_dir);
+  // A previous run's stats.json would describe this run's outputs if it stopped before writing
+  // its own (interrupted): stats.json exists only for a run that ended, and is this run's.
+  std::filesystem::remove(summary.output_dir / "stats.json");
   ProbeRecorder probes(summary.output_dir / "probes.csv", prepared.mesh, scene.output.probes,
                        std::move(probe_locations));
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");

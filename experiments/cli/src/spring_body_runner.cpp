@@ -149,6 +149,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   log.flush();
 
   std::filesystem::create_directories(summary.output_dir);
+  std::filesystem::remove(summary.output_dir / "stats.json");  // this run's only, once it ends
   CsvSeries probes(summary.output_dir / "probes.csv", "time,probe,x,y,z,ux,uy,uz");
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");
   std::optional<PvdWriter> pvd;
