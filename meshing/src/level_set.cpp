@@ -8,6 +8,7 @@
 #include <openvdb/tree/LeafManager.h>
 
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 
 #include "level_set_impl.hpp"
@@ -36,6 +37,26 @@ void check_level_set_options(const LevelSetOptions& options, const std::string& 
   if (!(options.half_width >= 1.0) || !std::isfinite(options.half_width))
     throw InputError(what + ": narrow-band half width must be at least 1 voxel, got " +
                      std::to_string(options.half_width));
+}
+
+void check_level_set_size(const Vector3d& lo, const Vector3d& hi, const LevelSetOptions& options,
+                          const std::string& what) {
+  // The estimate is about twice the band of a rounded body; 10⁹ takes several GB in OpenVDB's
+  // tree.
+  constexpr double kMaxBandVoxels = 1e9;
+  const Vector3d extent = (hi - lo).cwiseMax(options.voxel_size);
+  const double area =
+      2.0 * (extent.x() * extent.y() + extent.y() * extent.z() + extent.z() * extent.x());
+  const double voxels =
+      area / (options.voxel_size * options.voxel_size) * (2.0 * options.half_width + 1.0);
+  if (!(voxels <= kMaxBandVoxels)) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  ": voxel size %g m would need about %.2g voxels for a surface of this size (at "
+                  "most 1e9); use a larger voxel_size",
+                  options.voxel_size, voxels);
+    throw InputError(what + text);
+  }
 }
 
 }  // namespace detail
@@ -275,6 +296,9 @@ SurfaceLevelSet surface_to_level_set(const SurfaceMesh& surface, const LevelSetO
     throw InputError("surface level set: the surface is empty");
   if (!surface.vertices.allFinite())
     throw InputError("surface level set: the surface has non-finite vertex coordinates");
+  detail::check_level_set_size(surface.vertices.colwise().minCoeff().transpose(),
+                               surface.vertices.colwise().maxCoeff().transpose(), options,
+                               "surface level set");
   SurfaceLevelSet result;
   result.topology = surface_topology(surface);  // also checks the indices
   detail::ensure_openvdb_initialized();

@@ -22,6 +22,10 @@ LevelSet wrap_level_set(openvdb::FloatGrid::Ptr grid);
 
 /// Checks a voxel size and half width; InputError naming `what` otherwise.
 void check_level_set_options(const LevelSetOptions& options, const std::string& what);
+/// InputError naming `what` when a narrow band around a surface in the box [lo, hi] would hold
+/// more voxels than a level set here may (about the box's surface area / voxel² × band width).
+void check_level_set_size(const Vector3d& lo, const Vector3d& hi, const LevelSetOptions& options,
+                          const std::string& what);
 
 }  // namespace detail
 }  // namespace strata

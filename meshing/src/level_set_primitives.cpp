@@ -49,6 +49,7 @@ LevelSet level_set_from_function(const std::function<double(const Vector3d&)>& s
   detail::check_level_set_options(options, "level set '" + name + "'");
   check_finite(lo, "level set '" + name + "': box minimum");
   check_finite(hi, "level set '" + name + "': box maximum");
+  detail::check_level_set_size(lo, hi, options, "level set '" + name + "'");
   detail::ensure_openvdb_initialized();
   const double h = options.voxel_size;
   const double background = options.half_width * h;

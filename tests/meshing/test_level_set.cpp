@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <numbers>
 
 #include "core/io_test_utils.hpp"
@@ -309,6 +310,25 @@ TEST(LevelSet, BadInputIsRejected) {
   SurfaceMesh bad = box_surface(Vector3d(0, 0, 0), Vector3d(1, 1, 1));
   bad.triangles(3, 1) = 99;
   EXPECT_THROW(surface_to_level_set(bad, {0.05, 3.0}), InputError);
+  // A band too fine for its surface (about 10¹¹ voxels) is refused before any allocation, naming
+  // the voxel size; one a thousand times coarser is built.
+  for (const auto& build : std::vector<std::function<void(double)>>{
+           [](double h) {
+             level_set_sphere(kCenter, 1.0, {h, 3.0});
+           },
+           [](double h) {
+             surface_to_level_set(box_surface(Vector3d(0, 0, 0), Vector3d(2, 2, 2)), {h, 3.0});
+           }}) {
+    try {
+      build(2e-5);
+      ADD_FAILURE() << "a band of about 1e11 voxels was accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("voxel size 2e-05 m would need about"),
+                std::string::npos)
+          << error.what();
+    }
+    EXPECT_NO_THROW(build(2e-2));
+  }
 }
 
 }  // namespace
