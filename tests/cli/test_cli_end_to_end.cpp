@@ -401,7 +401,7 @@ TEST(CliEndToEnd, BadInputExitsWith2AndOneLineErrors) {
   EXPECT_EQ(result.exit_code, 2);
 }
 
-TEST(CliEndToEnd, OverflowingNumbersAndControlCharactersGiveOneLineBadInputErrors) {
+TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErrors) {
   TempFolder folder;
   // A literal beyond a double.
   write_text(folder.path() / "huge.json",
@@ -424,6 +424,19 @@ TEST(CliEndToEnd, OverflowingNumbersAndControlCharactersGiveOneLineBadInputError
   result = run_strata("run scene.json", folder.path());
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.err, HasSubstr("scene.json: material.youngs_modulus: must be at most 1e20"));
+  // A mesh the machine cannot hold is refused before it is built, naming the key.
+  scene = bar_scene();
+  scene["mesh"]["box"]["cells"] = {2000, 2000, 2000};
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("scene.json: mesh.box: cells: about 4.8e+10 tets would need"));
+  scene = bar_scene();
+  scene["hierarchy"] = {{"levels", 8}, {"mode", "full"}};
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("scene.json: hierarchy.levels: about"));
   // A newline inside a value the message quotes stays on the one line, escaped.
   scene = bar_scene();
   scene["material"]["model"] = "stvk\nstrata: error: a second line";

@@ -1,5 +1,6 @@
 #include <iostream>
 
+#include "memory_check.hpp"
 #include "strata/app/scene_runner.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/io/mesh_io.hpp"
@@ -34,6 +35,8 @@ PreparedMesh prepare_scene_mesh(const Scene& scene) {
       prepared.mesh = read_tet_mesh(*scene.mesh.file);
     } else {
       prepared.source = "box";
+      const auto& cells = scene.mesh.box_cells;
+      check_fits_in_memory(6.0 * cells[0] * cells[1] * cells[2], "cells");
       prepared.mesh = box_tet_mesh(scene.mesh.box_min, scene.mesh.box_max, scene.mesh.box_cells);
     }
     validate_tet_mesh(prepared.mesh, prepared.source);

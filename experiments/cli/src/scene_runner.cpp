@@ -1,5 +1,7 @@
 #include "strata/app/scene_runner.hpp"
 
+#include "memory_check.hpp"
+
 #include "spring_body_runner.hpp"
 
 #include <chrono>
@@ -106,6 +108,14 @@ class SceneSimulation {
   SceneSimulation(const Scene& scene, const TetMesh& mesh, const SurfaceBinding* binding,
                   const MatrixX3d* surface_rest) {
     try {
+      if (scene.hierarchy && scene.hierarchy->mode != HierarchyMode::adaptive) {
+        // Full and uniform cuts hold every tet of their level.
+        const HierarchySettings& h = *scene.hierarchy;
+        const int level = h.mode == HierarchyMode::full ? h.levels : h.level;
+        check_fits_in_memory(
+            std::ldexp(static_cast<double>(mesh.tets.rows()), 3 * level),
+            h.mode == HierarchyMode::full ? "hierarchy.levels" : "hierarchy.level");
+      }
       std::vector<Obstacle> obstacles = build_obstacles(scene, mesh);
       if (scene.hierarchy) {
         // The fine surface's vertices as material points of the tree (bound to the coarse mesh,
