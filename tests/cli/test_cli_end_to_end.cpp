@@ -401,6 +401,31 @@ TEST(CliEndToEnd, BadInputExitsWith2AndOneLineErrors) {
   EXPECT_EQ(result.exit_code, 2);
 }
 
+TEST(CliEndToEnd, StepCountsFollowTheDocumentedRuleAndItsLimits) {
+  TempFolder folder;
+  json scene = bar_scene();
+  // A duration below dt takes one step (⌈duration / dt⌉, at least one).
+  scene["solver"] = json::parse(
+      R"({"mode": "dynamic", "integrator": "implicit_euler", "dt": 1, "duration": 1e-9})");
+  write_scene(folder, scene);
+  CliResult result = run_strata("run scene.json --quiet", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(read_json(folder.path() / "out" / "scene" / "stats.json")["steps"], 1);
+  // Runs that would not end are refused at once.
+  scene["solver"]["dt"] = 1e-12;
+  scene["solver"]["duration"] = 1;
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(result.err,
+            "strata: error: scene.json: solver.dt: duration / dt = 1e+12 steps (at most 1e8)\n");
+  scene["solver"] = json::parse(R"({"mode": "static", "load_steps": 1000000000})");
+  write_scene(folder, scene);
+  result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("scene.json: solver.load_steps: must be at most 1e6"));
+}
+
 TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErrors) {
   TempFolder folder;
   // A literal beyond a double.

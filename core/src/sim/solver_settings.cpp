@@ -1,6 +1,7 @@
 #include "strata/core/sim/solver_settings.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "strata/core/common/error.hpp"
 
@@ -84,6 +85,16 @@ void validate_solver_settings(const SolverSettings& s, const std::string& where)
   if (!std::isfinite(s.ramp_time) || s.ramp_time < 0.0)
     throw InputError(where + ".ramp_time: must be a finite number >= 0");
   if (s.load_steps < 1) throw InputError(where + ".load_steps: must be >= 1");
+  // Runs of more steps than these would not end in any reasonable time (a static load step
+  // takes a Newton solve, a dynamic step at least microseconds).
+  if (s.mode == SimulationMode::static_equilibrium && s.load_steps > 1000000)
+    throw InputError(where + ".load_steps: must be at most 1e6");
+  if (s.mode == SimulationMode::dynamic && s.duration / s.dt > 1e8) {
+    char text[96];
+    std::snprintf(text, sizeof(text), ".dt: duration / dt = %.3g steps (at most 1e8)",
+                  s.duration / s.dt);
+    throw InputError(where + text);
+  }
   if (s.max_newton_iterations < 0)
     throw InputError(where + ".max_newton_iterations: must be >= 0 (0: automatic)");
   if (s.max_plastic_passes < 1) throw InputError(where + ".max_plastic_passes: must be >= 1");
