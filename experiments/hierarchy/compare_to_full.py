@@ -2,10 +2,11 @@
 """Error of hierarchy runs against full resolution, over the whole run.
 
 Runs a scene (which has a "hierarchy" key) once with hierarchy.mode=full — the reference, reused
-when its outputs are present from the same command, scene file and strata binary — and once per configuration given with --run NAME:key=value,... The
-error of a run is the largest probe-displacement difference to the full run over every frame and
-probe, relative to the largest full-resolution probe displacement (the measure hierarchy.tolerance
-bounds). Prints one line per run and writes <out>/compare.json:
+when its outputs are present from the same command, scene file and strata binary — and once per
+configuration given with --run NAME:key=value,... The error of a run is the largest
+probe-displacement difference to the full run over every frame and probe, relative to the largest
+full-resolution probe displacement (the measure hierarchy.tolerance bounds). Prints one line per
+run and writes <out>/compare.json:
 
   compare_to_full.py SCENE.json [--out DIR] [--strata PATH] [--field]
                      [--run adaptive:] [--run tight:tolerance=0.005] [--set key=value ...]

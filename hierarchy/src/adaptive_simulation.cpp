@@ -396,19 +396,22 @@ bool AdaptiveSimulation::children_stable(NodeId n) const {
   // children in any cut, so its estimate is a lower bound of theirs (refusal errs on the safe
   // side).
   const std::array<Matrix3x4d, 8> children = red_refine_tet(m_tree->bey_positions(n));
-  TetMesh mesh;
-  mesh.vertices.resize(32, 3);
-  mesh.tets.resize(8, 4);
-  for (int k = 0; k < 8; ++k) {
-    Matrix3x4d x = children[k];
+  return stable_on_their_own({children.begin(), children.end()});
+}
+
+bool AdaptiveSimulation::stable_on_their_own(const std::vector<Matrix3x4d>& tets) const {
+  MatrixX3d vertices(4 * static_cast<Index>(tets.size()), 3);
+  MatrixX4i elements(static_cast<Index>(tets.size()), 4);
+  for (Index t = 0; t < elements.rows(); ++t) {
+    Matrix3x4d x = tets[t];
     if ((x.col(1) - x.col(0)).cross(x.col(2) - x.col(0)).dot(x.col(3) - x.col(0)) < 0.0)
       x.col(2).swap(x.col(3));
     for (int c = 0; c < 4; ++c) {
-      mesh.vertices.row(4 * k + c) = x.col(c).transpose();
-      mesh.tets(k, c) = 4 * k + c;
+      vertices.row(4 * t + c) = x.col(c).transpose();
+      elements(t, c) = static_cast<int>(4 * t + c);
     }
   }
-  return stable_time_step_estimate(mesh.vertices, mesh.tets, m_material, m_solver.integrator) >=
+  return stable_time_step_estimate(vertices, elements, m_material, m_solver.integrator) >=
          m_solver.dt;
 }
 
@@ -762,15 +765,7 @@ bool AdaptiveSimulation::finest_level_stable() const {
             children.push_back(child);
         tets.swap(children);
       }
-      MatrixX3d vertices(4 * static_cast<Index>(tets.size()), 3);
-      MatrixX4i elements(static_cast<Index>(tets.size()), 4);
-      for (Index t = 0; t < elements.rows(); ++t)
-        for (int c = 0; c < 4; ++c) {
-          vertices.row(4 * t + c) = tets[t].col(c).transpose();
-          elements(t, c) = static_cast<int>(4 * t + c);
-        }
-      stable = stable_time_step_estimate(vertices, elements, m_material, m_solver.integrator) >=
-               m_solver.dt;
+      stable = stable_on_their_own(tets);
     }
     m_finest_level_stable = stable;
   }

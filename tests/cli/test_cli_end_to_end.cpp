@@ -401,6 +401,16 @@ TEST(CliEndToEnd, BadInputExitsWith2AndOneLineErrors) {
   EXPECT_EQ(result.exit_code, 2);
 }
 
+/// Writes `scene` as scene.json, runs it and expects exit 2 with one line on stderr holding
+/// `message`.
+void expect_refused(const TempFolder& folder, const json& scene, const std::string& message) {
+  write_scene(folder, scene);
+  const CliResult result = run_strata("run scene.json", folder.path());
+  EXPECT_EQ(result.exit_code, 2) << message;
+  EXPECT_THAT(result.err, HasSubstr(message));
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
 TEST(CliEndToEnd, StepCountsFollowTheDocumentedRuleAndItsLimits) {
   TempFolder folder;
   json scene = bar_scene();
@@ -408,22 +418,16 @@ TEST(CliEndToEnd, StepCountsFollowTheDocumentedRuleAndItsLimits) {
   scene["solver"] = json::parse(
       R"({"mode": "dynamic", "integrator": "implicit_euler", "dt": 1, "duration": 1e-9})");
   write_scene(folder, scene);
-  CliResult result = run_strata("run scene.json --quiet", folder.path());
+  const CliResult result = run_strata("run scene.json --quiet", folder.path());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(read_json(folder.path() / "out" / "scene" / "stats.json")["steps"], 1);
   // Runs that would not end are refused at once.
   scene["solver"]["dt"] = 1e-12;
   scene["solver"]["duration"] = 1;
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_EQ(result.err,
-            "strata: error: scene.json: solver.dt: duration / dt = 1e+12 steps (at most 1e8)\n");
+  expect_refused(folder, scene,
+                 "strata: error: scene.json: solver.dt: duration / dt = 1e+12 steps (at most 1e8)");
   scene["solver"] = json::parse(R"({"mode": "static", "load_steps": 1000000000})");
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("scene.json: solver.load_steps: must be at most 1e6"));
+  expect_refused(folder, scene, "scene.json: solver.load_steps: must be at most 1e6");
 }
 
 TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErrors) {
@@ -432,44 +436,28 @@ TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErro
   write_text(folder.path() / "huge.json",
              "{\"mesh\": {\"box\": {\"min\": [0, 0, 0], "
              "\"max\": [1e400, 1, 1], \"cells\": [1, 1, 1]}}}");
-  CliResult result = run_strata("run huge.json", folder.path());
+  const CliResult result = run_strata("run huge.json", folder.path());
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_EQ(result.err,
             "strata: error: huge.json: number overflow parsing '1e400' (not a finite double)\n");
   // Finite values whose products overflow: the weight, or the stiffness.
   json scene = bar_scene();
   scene["gravity"] = {0, 0, -1e300};
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("scene.json: loads: the masses or the loads"));
+  expect_refused(folder, scene, "scene.json: loads: the masses or the loads");
   scene = bar_scene();
   scene["material"]["youngs_modulus"] = 1e300;
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("scene.json: material.youngs_modulus: must be at most 1e20"));
+  expect_refused(folder, scene, "scene.json: material.youngs_modulus: must be at most 1e20");
   // A mesh the machine cannot hold is refused before it is built, naming the key.
   scene = bar_scene();
   scene["mesh"]["box"]["cells"] = {2000, 2000, 2000};
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("scene.json: mesh.box: cells: about 4.8e+10 tets would need"));
+  expect_refused(folder, scene, "scene.json: mesh.box: cells: about 4.8e+10 tets would need");
   scene = bar_scene();
   scene["hierarchy"] = {{"levels", 8}, {"mode", "full"}};
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.err, HasSubstr("scene.json: hierarchy.levels: about"));
+  expect_refused(folder, scene, "scene.json: hierarchy.levels: about");
   // A newline inside a value the message quotes stays on the one line, escaped.
   scene = bar_scene();
   scene["material"]["model"] = "stvk\nstrata: error: a second line";
-  write_scene(folder, scene);
-  result = run_strata("run scene.json", folder.path());
-  EXPECT_EQ(result.exit_code, 2);
-  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
-  EXPECT_THAT(result.err, HasSubstr("\"stvk\\nstrata: error: a second line\""));
+  expect_refused(folder, scene, "\"stvk\\nstrata: error: a second line\"");
 }
 
 TEST(CliEndToEnd, BadMeshFileIsNamed) {

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -342,38 +343,52 @@ TEST(AdaptiveTolerance, CoarseningKeepsTheEstimateWithinTheTolerance) {
     EXPECT_LE(sample.estimated_error, h.tolerance) << "step " << sample.step;
 }
 
+/// A slab clamped at its base with a 40 N patch load near each end, each load with an amplitude:
+/// the scene of the growing-load tests.
+struct TwoPatchSlab {
+  TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(0.6, 0.3, 0.1), {4, 2, 1});
+
+  std::unique_ptr<AdaptiveSimulation> simulation(
+      const HierarchySettings& hierarchy, const SolverSettings& solver,
+      const std::vector<std::array<double, 2>>& left_amplitude,
+      const std::vector<std::array<double, 2>>& right_amplitude) const {
+    Material material = rubber();
+    material.youngs_modulus = 1e5;
+    material.poisson_ratio = 0.35;
+    material.stiffness_damping = 0.001;
+    RegionLoad left =
+        box_load(Vector3d(0.06, 0.12, 0.1), Vector3d(0.12, 0.18, 0.1), Vector3d(0, 0, -40.0));
+    left.amplitude.points = left_amplitude;
+    RegionLoad right =
+        box_load(Vector3d(0.48, 0.12, 0.1), Vector3d(0.54, 0.18, 0.1), Vector3d(0, 0, -40.0));
+    right.name = "forces.1";
+    right.amplitude.points = right_amplitude;
+    return std::make_unique<AdaptiveSimulation>(
+        coarse, hierarchy, material,
+        std::vector<DirichletSpec>{fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
+        std::vector<RegionLoad>{left, right}, std::nullopt, Vector3d::Zero(), solver);
+  }
+};
+
 TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
-  // A slab clamped at its base; a patch load at its left end holds and then ramps down while one
-  // at its right end, idle at first, ramps up. The initial adaptation refines under both (every
-  // load at its peak). The decision at step 10 (t = 0.02 s) sees the right patch idle: when its
-  // load starts within the next 10 steps (at 0.03 s) nothing merges, so it does not meet its
-  // load on a coarse cut; when it starts only after them (at 0.045 s), the same decision merges,
-  // as it does when the right load holds a plateau (whose interpolated values may differ from the
-  // table's in the last bits).
-  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(0.6, 0.3, 0.1), {4, 2, 1});
-  Material material = rubber();
-  material.youngs_modulus = 1e5;
-  material.poisson_ratio = 0.35;
-  material.stiffness_damping = 0.001;
+  // The left load holds and then ramps down while the right one, idle at first, ramps up. The
+  // initial adaptation refines under both (every load at its peak). The decision at step 10
+  // (t = 0.02 s) sees the right patch idle: when its load starts within the next 10 steps (at
+  // 0.03 s) nothing merges, so it does not meet its load on a coarse cut; when it starts only
+  // after them (at 0.045 s), the same decision merges, as it does when the right load holds a
+  // plateau (whose interpolated values may differ from the table's in the last bits).
+  const TwoPatchSlab slab;
   SolverSettings solver;
   solver.integrator = Integrator::implicit_euler;
   solver.dt = 0.002;
   solver.duration = 0.03;
   const auto merges_at_step_10 = [&](const std::vector<std::array<double, 2>>& right_amplitude) {
-    RegionLoad left =
-        box_load(Vector3d(0.06, 0.12, 0.1), Vector3d(0.12, 0.18, 0.1), Vector3d(0, 0, -40.0));
-    left.amplitude.points = {{0.0, 1.0}, {0.03, 1.0}, {0.07, 0.0}};
-    RegionLoad right =
-        box_load(Vector3d(0.48, 0.12, 0.1), Vector3d(0.54, 0.18, 0.1), Vector3d(0, 0, -40.0));
-    right.name = "forces.1";
-    right.amplitude.points = right_amplitude;
-    AdaptiveSimulation sim(coarse, defaults(2), material,
-                           {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
-                           {left, right}, std::nullopt, Vector3d::Zero(), solver);
-    while (sim.step_count() < 10)
-      sim.advance();
+    const auto sim = slab.simulation(defaults(2), solver, {{0.0, 1.0}, {0.03, 1.0}, {0.07, 0.0}},
+                                     right_amplitude);
+    while (sim->step_count() < 10)
+      sim->advance();
     Index coarsened = 0;
-    for (const CutChangeRecord& change : sim.changes())
+    for (const CutChangeRecord& change : sim->changes())
       if (change.step == 10) coarsened += change.coarsened;
     return coarsened;
   };
@@ -383,35 +398,24 @@ TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
 }
 
 TEST(AdaptiveTolerance, StaticRunsMergeBetweenLoadStepsAndNotWhileALoadStillGrows) {
-  // The slab of the test above over 40 static load steps (τ = 5 %): the left patch load holds until
-  // λ = 0.2 and is gone at 0.3; the right one is idle until 0.25 and then grows, either to the end
-  // (no merge may be made: at every decision it grows within the next load step) or until 0.35
-  // and then holds (merges may follow from the decision at λ = 0.35 on, whose next load step no
-  // longer raises it). Merges are made after a load step, on its equilibrium, and refine nothing;
-  // the load step's own passes only refine.
-  const TetMesh coarse = box_tet_mesh(Vector3d::Zero(), Vector3d(0.6, 0.3, 0.1), {4, 2, 1});
-  Material material = rubber();
-  material.youngs_modulus = 1e5;
-  material.poisson_ratio = 0.35;
+  // The same slab over 40 static load steps (τ = 5 %): the left load holds until λ = 0.2 and is
+  // gone at 0.3; the right one is idle until 0.25 and then grows, either to the end (no merge may
+  // be made: at every decision it grows within the next load step) or until 0.35 and then holds
+  // (merges may follow from the decision at λ = 0.35 on, whose next load step no longer raises
+  // it). Merges are made after a load step, on its equilibrium, and refine nothing; the load
+  // step's own passes only refine.
+  const TwoPatchSlab slab;
   SolverSettings solver;
   solver.mode = SimulationMode::static_equilibrium;
   solver.load_steps = 40;
   HierarchySettings hierarchy = defaults(2);
   hierarchy.tolerance = 0.05;
   const auto run = [&](const std::vector<std::array<double, 2>>& right_amplitude) {
-    RegionLoad left =
-        box_load(Vector3d(0.06, 0.12, 0.1), Vector3d(0.12, 0.18, 0.1), Vector3d(0, 0, -40.0));
-    left.amplitude.points = {{0.0, 1.0}, {0.2, 1.0}, {0.3, 0.0}};
-    RegionLoad right =
-        box_load(Vector3d(0.48, 0.12, 0.1), Vector3d(0.54, 0.18, 0.1), Vector3d(0, 0, -40.0));
-    right.name = "forces.1";
-    right.amplitude.points = right_amplitude;
-    AdaptiveSimulation sim(coarse, hierarchy, material,
-                           {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
-                           {left, right}, std::nullopt, Vector3d::Zero(), solver);
-    while (!sim.finished())
-      sim.advance();
-    return sim.changes();
+    const auto sim =
+        slab.simulation(hierarchy, solver, {{0.0, 1.0}, {0.2, 1.0}, {0.3, 0.0}}, right_amplitude);
+    while (!sim->finished())
+      sim->advance();
+    return sim->changes();
   };
   Index grows_to_the_end = 0;
   for (const CutChangeRecord& change : run({{0.0, 0.0}, {0.25, 0.0}, {1.0, 1.0}}))

@@ -274,10 +274,7 @@ double Simulation::load_factor() const {
 }
 
 bool Simulation::finished() const {
-  if (is_static()) return m_steps >= m_settings.load_steps;
-  // ⌈duration / dt⌉ steps, at least one (a duration below dt takes one step).
-  const double steps = std::ceil(m_settings.duration / m_settings.dt - 1e-9);
-  return static_cast<double>(m_steps) >= std::max(1.0, steps);
+  return m_steps >= planned_steps(m_settings);
 }
 
 void Simulation::advance() {

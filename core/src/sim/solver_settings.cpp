@@ -1,5 +1,6 @@
 #include "strata/core/sim/solver_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -66,6 +67,11 @@ LinearSolverKind linear_solver_from_string(const std::string& name) {
 int newton_iteration_limit(const SolverSettings& settings, bool contact) {
   if (settings.max_newton_iterations > 0) return settings.max_newton_iterations;
   return contact ? 200 : 50;
+}
+
+long planned_steps(const SolverSettings& settings) {
+  if (settings.mode == SimulationMode::static_equilibrium) return settings.load_steps;
+  return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
 }
 
 void validate_solver_settings(const SolverSettings& s, const std::string& where) {

@@ -309,7 +309,7 @@ VectorXd SpringBodySimulation::forces(const VectorXd& x, const VectorXd& v, doub
 }
 
 bool SpringBodySimulation::finished() const {
-  return time() >= m_settings.duration - 1e-9 * m_settings.dt;
+  return m_steps >= planned_steps(m_settings);
 }
 
 double SpringBodySimulation::kinetic_energy() const {

@@ -41,12 +41,6 @@ bool is_explicit(const SolverSettings& settings) {
          settings.integrator != Integrator::implicit_euler;
 }
 
-/// Steps the run will take: ⌈duration/dt⌉ (dynamic, as Simulation::finished) or load_steps.
-long planned_steps(const SolverSettings& settings) {
-  if (settings.mode == SimulationMode::static_equilibrium) return settings.load_steps;
-  return std::max(1L, static_cast<long>(std::ceil(settings.duration / settings.dt - 1e-9)));
-}
-
 }  // namespace
 
 namespace detail {

@@ -122,8 +122,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
     rest_positions.segment<3>(3 * i) = body.rest.row(i).transpose();
   const MatrixX3d shown_rest = shown_points(rest_positions);
   const std::vector<Index> probe_points = locate_probes(scene, shown_rest);
-  const long total_steps =
-      static_cast<long>(std::ceil(scene.solver.duration / scene.solver.dt - 1e-9));
+  const long total_steps = planned_steps(scene.solver);
   if (!options.quiet) {
     log << "strata: " << scene.file.string() << ": skeleton springs on "
         << scene.mesh.surface->string() << ": " << body.num_surface << " surface vertices"

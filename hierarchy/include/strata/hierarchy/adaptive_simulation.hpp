@@ -303,6 +303,9 @@ class AdaptiveSimulation final : public SimulationRun {
   RecoveryEstimate estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
+  /// Whether solver.dt is within the stable-step estimate of `tets` (Bey-ordered positions) as a
+  /// mesh of their own.
+  bool stable_on_their_own(const std::vector<Matrix3x4d>& tets) const;
   /// Static runs, after a refinement pass re-solved its load step: the pass's change (largest
   /// vertex displacement difference between the carried state `carried` and the new
   /// equilibrium, relative to the largest displacement) bounds the refined cut's error from

@@ -60,9 +60,14 @@ LinearSolverKind linear_solver_from_string(const std::string& name);
 /// contact).
 int newton_iteration_limit(const SolverSettings& settings, bool contact);
 
+/// The steps a run takes: load_steps (static), or ⌈duration / dt⌉ and at least one (dynamic; a
+/// duration below dt takes one step).
+long planned_steps(const SolverSettings& settings);
+
 /// Throws InputError naming `where` (e.g. "solver") unless dt > 0, duration > 0, ramp_time ≥ 0,
-/// load_steps ≥ 1, max_newton_iterations ≥ 0, newton_tolerance > 0, contact factor > 0,
-/// max_plastic_passes ≥ 1, plastic_tolerance > 0 (all finite).
+/// load_steps in [1, 1e6], max_newton_iterations ≥ 0, newton_tolerance > 0, contact factor > 0,
+/// max_plastic_passes ≥ 1, plastic_tolerance > 0 (all finite), and a dynamic run takes at most
+/// 1e8 steps.
 void validate_solver_settings(const SolverSettings& settings, const std::string& where);
 
 }  // namespace strata
