@@ -26,6 +26,45 @@ constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;
 constexpr int kExitDiverged = 3;
 
+/// A whole number in [minimum, maximum]; the message quotes the bounds as integers.
+CLI::Validator whole_number(long minimum, long maximum) {
+  return CLI::Validator(
+      [minimum, maximum](std::string& text) -> std::string {
+        long value = 0;
+        std::size_t used = 0;
+        try {
+          value = std::stol(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (text.empty() || used != text.size())
+          return "expected a whole number, got '" + text + "'";
+        if (value < minimum || value > maximum)
+          return "must be between " + std::to_string(minimum) + " and " + std::to_string(maximum) +
+                 ", got " + text;
+        return {};
+      },
+      "INT in [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]");
+}
+
+/// A number strictly between 0 and 1.
+CLI::Validator open_unit_interval() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        std::size_t used = 0;
+        try {
+          value = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (text.empty() || used != text.size()) return "expected a number, got '" + text + "'";
+        if (!(value > 0.0 && value < 1.0)) return "must be in (0, 1), got " + text;
+        return {};
+      },
+      "in (0, 1)");
+}
+
 /// One line whatever the message holds: control characters (a newline or NUL inside a key, a
 /// value or a file name the message quotes) are written as escapes.
 std::string one_line(const std::string& message) {
@@ -129,7 +168,7 @@ int main(int argc, char** argv) {
   run->add_option("--threads", threads,
                   "Threads of strata's parallel loops (default 0: every core); the BLAS and "
                   "OpenMP threads of the sparse solver stay at 1 so that nothing oversubscribes")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number(0, 4096));
 
   CLI::App* info = app.add_subcommand("info", "Print counts, volume and quality of a tet mesh");
   std::string info_file;
@@ -184,11 +223,12 @@ int main(int argc, char** argv) {
   precompute
       ->add_option("--tolerance", precompute_command.tolerance,
                    "hierarchy.tolerance of the recorded runs (default: half of each scene's)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(open_unit_interval());
   precompute
       ->add_option("--windows", precompute_command.windows,
-                   "Cuts in the schedule: equal windows of the run's time (default 1: one cut)")
-      ->check(CLI::PositiveNumber);
+                   "Cuts in the schedule: equal windows of the run's time (default 1: one cut; at "
+                   "most the longest run's steps)")
+      ->check(whole_number(1, 1000000));
   precompute
       ->add_option("--set", precompute_command.overrides,
                    "Override a key of every scene: key.path=value (as for run)")
@@ -196,7 +236,7 @@ int main(int argc, char** argv) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   precompute->add_flag("-q,--quiet", precompute_command.quiet, "No info lines");
   precompute->add_option("--threads", threads, "Threads of strata's parallel loops (as for run)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number(0, 4096));
 
   try {
     app.parse(argc, argv);
@@ -213,6 +253,8 @@ int main(int argc, char** argv) {
   try {
     strata::set_thread_policy({.threads = threads});
     if (*run) {
+      if (run->count("--out") > 0 && out_dir.empty())
+        throw strata::InputError("--out: the output folder must not be empty");
       const strata::app::Scene scene = strata::app::load_scene(scene_file, overrides);
       strata::app::RunOptions options;
       options.output_dir = out_dir;

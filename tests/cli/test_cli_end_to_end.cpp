@@ -8,6 +8,7 @@
 #include <gnu/libc-version.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -458,6 +459,111 @@ TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErro
   scene = bar_scene();
   scene["material"]["model"] = "stvk\nstrata: error: a second line";
   expect_refused(folder, scene, "\"stvk\\nstrata: error: a second line\"");
+}
+
+/// Runs `arguments` in `folder` and expects exit 2 with exactly the one line `line` on stderr.
+void expect_error_line(const TempFolder& folder, const std::string& arguments,
+                       const std::string& line) {
+  const CliResult result = run_strata(arguments, folder.path());
+  EXPECT_EQ(result.exit_code, 2) << arguments;
+  EXPECT_EQ(result.err, "strata: error: " + line + "\n") << arguments;
+}
+
+TEST(CliEndToEnd, DuplicateKeysFoldersAndFilesAreNamedInTheError) {
+  TempFolder folder;
+  // nlohmann's parser keeps the last of two equal keys; the scene reader refuses them.
+  write_text(folder.path() / "twice.json", R"({"mesh": {"box": {"cells": [1, 1, 1],
+      "min": [0, 0, 0], "max": [1, 1, 1]}}, "fixed": [{"box": {"min": [0, 0, 0],
+      "max": [0, 1, 1], "min": [1, 1, 1]}}]})");
+  expect_error_line(folder, "run twice.json",
+                    "twice.json: fixed.0.box.min: duplicate key (each key may appear once in an "
+                    "object)");
+  std::filesystem::create_directories(folder.path() / "folder.json");
+  expect_error_line(folder, "run folder.json", "folder.json: is a folder, not a JSON file");
+  // Files named by the scene are checked when it is read, under their key.
+  json scene = bar_scene();
+  scene["obstacles"] = json::array({{{"surface", "nothere.off"}}});
+  expect_refused(folder, scene,
+                 "scene.json: obstacles.0.surface: cannot read 'nothere.off': no such file");
+  scene = bar_scene();
+  scene["mesh"] = {{"file", "folder.json"}};
+  expect_refused(folder, scene, "scene.json: mesh.file: cannot read 'folder.json': it is a folder");
+  // "surface" frames need a fine surface.
+  scene = bar_scene();
+  scene["output"]["vtk"] = "surface";
+  expect_refused(folder, scene, "scene.json: output.vtk: \"surface\" writes the fine surface");
+  // Integers beyond an int say so.
+  scene = bar_scene();
+  scene["mesh"]["box"]["cells"][0] = 3e9;
+  expect_refused(folder, scene,
+                 "scene.json: mesh.box.cells.0: must be an integer of at most 2147483647");
+}
+
+TEST(CliEndToEnd, OutputFolderAndProgressFileProblemsAreBadInput) {
+  TempFolder folder;
+  write_scene(folder, bar_scene());
+  write_text(folder.path() / "afile", "x");
+  expect_error_line(folder, "run scene.json --out afile/sub",
+                    "output folder 'afile/sub': 'afile' is a file, not a folder");
+  expect_error_line(folder, "run scene.json --out afile",
+                    "output folder 'afile': 'afile' is a file, not a folder");
+  expect_error_line(folder, "run scene.json --out ''",
+                    "--out: the output folder must not be empty");
+  expect_error_line(folder, "run scene.json --out o --progress-file nodir/p.txt",
+                    "--progress-file 'nodir/p.txt': cannot write it (no folder 'nodir')");
+  expect_error_line(folder, "run scene.json --out o --progress-file o",
+                    "--progress-file 'o': cannot write it (it is a folder)");
+  EXPECT_FALSE(std::filesystem::exists(folder.path() / "o" / "stats.json"));
+  expect_error_line(folder, "run scene.json --threads abc",
+                    "--threads: expected a whole number, got 'abc'");
+  expect_error_line(folder, "run scene.json --threads -1",
+                    "--threads: must be between 0 and 4096, got -1");
+}
+
+TEST(CliEndToEnd, ASecondRunIntoTheSameFolderIsRefusedWhileTheFirstWrites) {
+  TempFolder folder;
+  json scene = bar_scene();
+  scene["solver"] = json::parse(
+      R"({"mode": "dynamic", "integrator": "implicit_euler", "dt": 1e-3, "duration": 100})");
+  scene["output"]["vtk"] = false;
+  write_scene(folder, scene, "long.json");
+  write_scene(folder, bar_scene());
+  // The long run holds out/ until it is killed; the progress file says when it has started.
+  const std::string command = "cd '" + folder.path().string() + "' && exec '" + STRATA_CLI_PATH +
+                              "' run long.json --out out -q --progress-file progress.txt";
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  for (int i = 0; i < 600 && !std::filesystem::exists(folder.path() / "progress.txt"); ++i)
+    usleep(50000);
+  ASSERT_TRUE(std::filesystem::exists(folder.path() / "progress.txt"));
+  const CliResult second = run_strata("run scene.json --out out -q", folder.path());
+  kill(child, SIGKILL);
+  int status = 0;
+  waitpid(child, &status, 0);
+  EXPECT_EQ(second.exit_code, 2);
+  EXPECT_EQ(second.err,
+            "strata: error: output folder 'out': another strata run is writing to it (give each "
+            "run its own --out)\n");
+  // Once the first run is gone the folder is free again.
+  const CliResult third = run_strata("run scene.json --out out -q", folder.path());
+  EXPECT_EQ(third.exit_code, 0) << third.err;
+}
+
+TEST(CliEndToEnd, AStaticBodyItsConstraintsDoNotHoldIsToldWhy) {
+  TempFolder folder;
+  json scene = bar_scene();
+  // One fixed corner vertex: the bar can still turn about it.
+  scene["fixed"] = json::array({{{"sphere", {{"center", {0, 0, 0}}, {"radius", 1e-3}}}}});
+  write_scene(folder, scene);
+  const CliResult result = run_strata("run scene.json -q", folder.path());
+  EXPECT_EQ(result.exit_code, 3);
+  EXPECT_THAT(result.err, HasSubstr("the fixed and prescribed groups leave 3 rigid motions of the "
+                                    "body free"));
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
 }
 
 TEST(CliEndToEnd, BadMeshFileIsNamed) {

@@ -140,7 +140,8 @@ TEST(CliMesh, SceneWithMissingSurfaceNamesTheKey) {
   const CliResult result = run_strata("run scene.json --quiet", folder.path());
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.err, HasSubstr("scene.json: mesh.surface: "));
-  EXPECT_THAT(result.err, HasSubstr("nothere.stl: no such file"));
+  EXPECT_THAT(result.err,
+              HasSubstr("scene.json: mesh.surface: cannot read 'nothere.stl': no such file"));
   EXPECT_EQ(count_lines(result.err), 1) << result.err;
 }
 

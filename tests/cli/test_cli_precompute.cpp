@@ -156,6 +156,24 @@ TEST(CliPrecompute, BadInputGetsOneLineErrors) {
               HasSubstr("bad.json: windows.0.refined."));
   EXPECT_THAT(error("run train.json -q" + precomputed + " --set hierarchy.cut='\"bad.json\"'"),
               HasSubstr("is not a node path"));
+  // A cut belongs to one tree: its levels and its keys are checked.
+  cut = read_json(folder.path() / "cut.json");
+  cut["extra"] = 1;
+  write_text(folder.path() / "extra.json", cut.dump());
+  EXPECT_THAT(error("run train.json -q" + precomputed + " --set hierarchy.cut='\"extra.json\"'"),
+              HasSubstr("extra.json: extra: unknown key"));
+  EXPECT_THAT(error("run train.json -q --set hierarchy.levels=1" + precomputed +
+                    " --set hierarchy.cut='\"cut.json\"'"),
+              HasSubstr("hierarchy.levels: is 1, and the cut 'cut.json' was recorded with 2 "
+                        "levels"));
+  // --tolerance 0 is not a tolerance, and a window holds at least one step (the slab takes 10).
+  EXPECT_THAT(error("precompute train.json --out c2.json -q --tolerance 0"),
+              HasSubstr("--tolerance: must be in (0, 1), got 0"));
+  EXPECT_THAT(error("precompute train.json --out c2.json -q --windows 11"),
+              HasSubstr("--windows 11 exceeds the 10 steps of the longest run"));
+  EXPECT_THAT(error("precompute train.json --out c2.json -q --windows 1000000000"),
+              HasSubstr("--windows: must be between 1 and 1000000"));
+  EXPECT_FALSE(std::filesystem::exists(folder.path() / "c2.json"));
 }
 
 }  // namespace

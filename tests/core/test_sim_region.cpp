@@ -79,6 +79,36 @@ TEST(SimDirichlet, EmptyGroupIsNamedAndLaterGroupsWin) {
   EXPECT_TRUE(groups[1].moment_center.isApprox(Vector3d(1.5, 0.5, 0.5)));
 }
 
+TEST(SimDirichlet, FreeRigidMotionsCountWhatTheConstraintsLeave) {
+  // Vertices of a unit cube's corners, as a 3·#V rest vector.
+  VectorXd rest(3 * 8);
+  for (int i = 0; i < 8; ++i)
+    rest.segment<3>(3 * i) = Vector3d(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const auto group = [](std::vector<int> vertices,
+                        std::array<bool, 3> components = {true, true, true}) {
+    DirichletGroup result;
+    result.vertices = std::move(vertices);
+    result.spec.components = components;
+    return result;
+  };
+  EXPECT_EQ(free_rigid_motions({}, rest), 6);
+  EXPECT_EQ(free_rigid_motions({group({0})}, rest), 3);              // turns about the vertex
+  EXPECT_EQ(free_rigid_motions({group({0, 1})}, rest), 1);           // turns about the edge's line
+  EXPECT_EQ(free_rigid_motions({group({0, 3})}, rest), 1);           // a face diagonal: a line too
+  EXPECT_EQ(free_rigid_motions({group({0, 1, 2})}, rest), 0);        // three points not on one line
+  EXPECT_EQ(free_rigid_motions({group({0}), group({7})}, rest), 1);  // groups add up
+  // Rollers: x held on the face x = 0 leaves the y, z slides and the turn about x.
+  EXPECT_EQ(free_rigid_motions({group({0, 2, 4, 6}, {true, false, false})}, rest), 3);
+  // z held on the bottom face, and x, y at one corner: only the turn about z at that corner.
+  EXPECT_EQ(free_rigid_motions(
+                {group({0, 1, 2, 3}, {false, false, true}), group({0}, {true, true, false})}, rest),
+            1);
+  EXPECT_EQ(free_rigid_motions({group({0, 1, 2, 3}, {false, false, true}),
+                                group({0}, {true, true, false}), group({1}, {false, true, false})},
+                               rest),
+            0);
+}
+
 TEST(SimDirichlet, RotationTargetsAreRigidAndVelocitiesMatchDerivatives) {
   DirichletGroup group;
   group.spec.kind = DirichletKind::rotation;

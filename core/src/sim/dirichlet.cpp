@@ -1,7 +1,10 @@
 #include "strata/core/sim/dirichlet.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "strata/core/common/error.hpp"
 
@@ -108,6 +111,46 @@ std::vector<char> dirichlet_dof_mask(const std::vector<DirichletGroup>& groups,
       for (int c = 0; c < 3; ++c)
         mask[3 * v + c] = group.spec.components[c] ? 1 : 0;
   return mask;
+}
+
+int free_rigid_motions(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest) {
+  // A rigid velocity t + ω × (X − c) keeps a prescribed coordinate k still when
+  // t_k + (ω × r)_k = 0, r = (X − c) / L. Each such coordinate adds the row a with a·(t, ω) = 0 to
+  // the Gram matrix Σ aᵀa; its null space is the motions left free.
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::max());
+  Vector3d hi = -lo;
+  Vector3d center = Vector3d::Zero();
+  Index count = 0;
+  for (const DirichletGroup& group : groups)
+    for (int v : group.vertices) {
+      const Vector3d X = rest.segment<3>(3 * v);
+      lo = lo.cwiseMin(X);
+      hi = hi.cwiseMax(X);
+      center += X;
+      ++count;
+    }
+  if (count == 0) return 6;
+  center /= static_cast<double>(count);
+  const double length = std::max((hi - lo).norm(), std::numeric_limits<double>::min());
+  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const DirichletGroup& group : groups)
+    for (int v : group.vertices) {
+      const Vector3d r = (rest.segment<3>(3 * v) - center) / length;
+      for (int k = 0; k < 3; ++k) {
+        if (!group.spec.components[k]) continue;
+        Eigen::Matrix<double, 6, 1> a = Eigen::Matrix<double, 6, 1>::Zero();
+        a(k) = 1.0;
+        // (ω × r)_k = ω · (r × e_k)
+        a.tail<3>() = r.cross(Vector3d::Unit(k));
+        gram += a * a.transpose();
+      }
+    }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(gram);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  int free = 0;
+  for (int i = 0; i < 6; ++i)
+    free += eigen.eigenvalues()(i) <= 1e-10 * largest ? 1 : 0;
+  return free;
 }
 
 void apply_dirichlet(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest, double t,

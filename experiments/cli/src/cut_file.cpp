@@ -30,6 +30,18 @@ Index count(const nlohmann::json& value, const std::string& where) {
   return static_cast<Index>(value.get<long long>());
 }
 
+/// Throws for a key of `object` outside `allowed`, naming it ("cut.json: windows.0.extra").
+void expect_keys(const nlohmann::json& object, std::initializer_list<const char*> allowed,
+                 const std::string& where) {
+  if (!object.is_object()) return;
+  for (const auto& [key, value] : object.items()) {
+    bool known = false;
+    for (const char* name : allowed)
+      known = known || key == name;
+    if (!known) throw InputError(where + (where.empty() ? "" : ".") + key + ": unknown key");
+  }
+}
+
 }  // namespace
 
 PrecomputedCut read_cut_file(const std::filesystem::path& file) {
@@ -38,6 +50,9 @@ PrecomputedCut read_cut_file(const std::filesystem::path& file) {
   const auto at = [&](const std::string& key) { return name + ": " + key; };
   try {
     if (!root.is_object()) throw InputError(name + ": must be a JSON object");
+    expect_keys(root,
+                {"format", "version", "coarse_mesh", "levels", "tolerance", "sources", "windows"},
+                "");
     if (member(root, "format", "") != kFormat)
       throw InputError(at("format") + ": expected \"" + kFormat + "\"");
     if (member(root, "version", "") != kVersion)
@@ -45,6 +60,7 @@ PrecomputedCut read_cut_file(const std::filesystem::path& file) {
     PrecomputedCut cut;
     cut.name = name;
     const nlohmann::json& coarse = member(root, "coarse_mesh", "");
+    expect_keys(coarse, {"vertices", "tets", "centroid"}, "coarse_mesh");
     cut.coarse_vertices =
         count(member(coarse, "vertices", "coarse_mesh"), at("coarse_mesh.vertices"));
     cut.coarse_tets = count(member(coarse, "tets", "coarse_mesh"), at("coarse_mesh.tets"));
@@ -63,6 +79,7 @@ PrecomputedCut read_cut_file(const std::filesystem::path& file) {
       throw InputError(at("windows") + ": must be a non-empty array");
     for (std::size_t w = 0; w < windows.size(); ++w) {
       const std::string key = "windows." + std::to_string(w);
+      expect_keys(windows[w], {"start", "end", "refined"}, key);
       CutWindow window;
       window.start = number(member(windows[w], "start", key), at(key + ".start"));
       window.end = number(member(windows[w], "end", key), at(key + ".end"));

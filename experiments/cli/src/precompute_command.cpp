@@ -43,6 +43,16 @@ void run_precompute_command(const PrecomputeCommand& command, std::ostream& log)
   if (command.output.extension() != ".json")
     throw InputError("precompute: --out " + command.output.string() + ": must be a .json file");
   if (!command.mesh.empty()) mesh_format_of(command.mesh);  // unknown extensions fail early
+  // A window holds at least one step (or load step) of the longest run.
+  long longest = 0;
+  for (const std::filesystem::path& file : command.scenes) {
+    const Scene scene = load_scene(file, command.overrides);
+    longest = std::max(longest, planned_steps(scene.solver));
+  }
+  if (command.windows > longest)
+    throw InputError("precompute: --windows " + std::to_string(command.windows) + " exceeds the " +
+                     std::to_string(longest) +
+                     " steps of the longest run (a window holds at least one step)");
 
   CutRecorder recorder;
   TetMesh coarse;

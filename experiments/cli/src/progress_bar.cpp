@@ -9,6 +9,8 @@
 #include <system_error>
 #include <utility>
 
+#include "strata/core/common/error.hpp"
+
 namespace strata::app {
 
 bool stderr_is_terminal() {
@@ -35,24 +37,42 @@ ProgressBar::ProgressBar(bool enabled, std::filesystem::path file)
       m_file(std::move(file)),
       m_start(std::chrono::steady_clock::now()),
       m_last_draw(m_start),
-      m_last_write(m_start) {}
+      m_last_write(m_start) {
+  if (m_file.empty()) return;
+  const std::string problem = write_file(0.0, 0.0);
+  if (!problem.empty())
+    throw InputError("--progress-file '" + m_file.string() + "': cannot write it (" + problem +
+                     ")");
+}
 
 ProgressBar::~ProgressBar() {
   clear();
 }
 
-void ProgressBar::write_file(double fraction, double elapsed) {
+std::string ProgressBar::write_file(double fraction, double elapsed) {
   // Written beside and renamed over the file, so that a reader never sees it half-written.
   std::filesystem::path part = m_file;
   part += ".part";
   {
     std::ofstream out(part, std::ios::trunc);
-    if (!out) return;
+    if (!out) {
+      std::error_code error;
+      const std::filesystem::path folder =
+          m_file.parent_path().empty() ? std::filesystem::path(".") : m_file.parent_path();
+      return std::filesystem::is_directory(folder, error) ? "not writable"
+                                                          : "no folder '" + folder.string() + "'";
+    }
     out << fraction << ' ' << elapsed << '\n';
-    if (!out) return;
+    if (!out) return "write failed";
   }
   std::error_code error;
   std::filesystem::rename(part, m_file, error);
+  if (error) {
+    std::filesystem::remove(part, error);
+    return std::filesystem::is_directory(m_file, error) ? "it is a folder"
+                                                        : "cannot rename onto it";
+  }
+  return {};
 }
 
 void ProgressBar::update(double fraction, const std::string& label) {

@@ -1,11 +1,61 @@
 #include "strata/app/run_outputs.hpp"
 
-#include <sstream>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+#include <system_error>
+
+#include "strata/core/common/error.hpp"
 #include "strata/core/io/atomic_file.hpp"
 #include "strata/core/io/number_text.hpp"
 
 namespace strata::app {
+
+void check_output_folder(const std::filesystem::path& folder) {
+  if (folder.empty()) throw InputError("--out: the output folder must not be empty");
+  // The folder itself, then each of its parents: the first that exists must be a folder.
+  std::filesystem::path part = folder;
+  while (!part.empty()) {
+    std::error_code error;
+    const std::filesystem::file_status status = std::filesystem::status(part, error);
+    if (std::filesystem::exists(status)) {
+      if (std::filesystem::is_directory(status)) return;
+      throw InputError("output folder '" + folder.string() + "': '" + part.string() +
+                       "' is a file, not a folder");
+    }
+    const std::filesystem::path parent = part.parent_path();
+    if (parent == part) return;
+    part = parent;
+  }
+}
+
+OutputFolder::OutputFolder(const std::filesystem::path& folder) {
+  check_output_folder(folder);
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error)
+    throw InputError("output folder '" + folder.string() + "': cannot create it (" +
+                     error.message() + ")");
+  const std::filesystem::path lock = folder / ".strata.lock";
+  m_lock = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (m_lock < 0)
+    throw InputError("output folder '" + folder.string() + "': cannot write in it (" +
+                     std::strerror(errno) + ")");
+  if (::flock(m_lock, LOCK_EX | LOCK_NB) != 0) {
+    ::close(m_lock);
+    m_lock = -1;
+    throw InputError("output folder '" + folder.string() +
+                     "': another strata run is writing to it (give each run its own --out)");
+  }
+}
+
+OutputFolder::~OutputFolder() {
+  if (m_lock >= 0) ::close(m_lock);  // closing releases the lock
+}
 
 std::string format_double(double value) {
   std::ostringstream out;

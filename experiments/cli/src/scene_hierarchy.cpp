@@ -31,6 +31,12 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
     std::filesystem::path path(name);
     if (!path.is_absolute()) path = folder / path;
     settings.precomputed = std::make_shared<const PrecomputedCut>(read_cut_file(path));
+    if (settings.precomputed->levels != settings.levels) {
+      value.at("levels").fail("is " + std::to_string(settings.levels) + ", and the cut '" + name +
+                              "' was recorded with " +
+                              std::to_string(settings.precomputed->levels) +
+                              " levels (a cut belongs to one tree)");
+    }
   } else if (value.has("cut")) {
     value.at("cut").fail("only with mode \"precomputed\"");
   }

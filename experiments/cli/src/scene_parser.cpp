@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "scene_hierarchy.hpp"
@@ -65,6 +66,34 @@ std::filesystem::path parse_path(const SceneValue& value, const std::filesystem:
   if (name.empty()) value.fail("must not be empty");
   const std::filesystem::path path(name);
   return path.is_absolute() ? path : folder / path;
+}
+
+/// Throws SceneKeyError naming `key` unless `path` is an existing file.
+void check_input_file(const std::string& scene_file, const std::string& key,
+                      const std::filesystem::path& path) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (!std::filesystem::exists(status))
+    throw SceneKeyError(scene_file, key, "cannot read '" + path.string() + "': no such file",
+                        false);
+  if (std::filesystem::is_directory(status))
+    throw SceneKeyError(scene_file, key, "cannot read '" + path.string() + "': it is a folder",
+                        false);
+}
+
+/// The files a scene names, checked when it is loaded (parse_scene alone reads none of them).
+void check_input_files(const Scene& scene) {
+  const std::string file = scene.file.string();
+  if (scene.mesh.file) check_input_file(file, "mesh.file", *scene.mesh.file);
+  if (scene.mesh.surface) check_input_file(file, "mesh.surface", *scene.mesh.surface);
+  if (scene.mesh.level_set) check_input_file(file, "mesh.level_set", *scene.mesh.level_set);
+  for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
+    const std::string key = "obstacles." + std::to_string(i);
+    if (scene.obstacles[i].surface)
+      check_input_file(file, key + ".surface", *scene.obstacles[i].surface);
+    if (scene.obstacles[i].level_set)
+      check_input_file(file, key + ".level_set", *scene.obstacles[i].level_set);
+  }
 }
 
 /// The Mesh_3 keys beside "surface".
@@ -332,6 +361,61 @@ OutputSpec parse_output(const SceneValue& value) {
   return output;
 }
 
+/// Finds the first key that appears twice in one JSON object (nlohmann keeps the last one
+/// silently) and records its path, "material.youngs_modulus" or "fixed.1.box".
+struct DuplicateKeyCheck {
+  struct Frame {
+    bool array = false;
+    long index = 0;
+    std::string key;
+    std::set<std::string> keys;
+  };
+  std::vector<Frame> frames;
+  std::string duplicate;
+
+  std::string path() const {
+    std::string result;
+    for (const Frame& frame : frames) {
+      const std::string part = frame.array ? std::to_string(frame.index) : frame.key;
+      result += (result.empty() ? "" : ".") + part;
+    }
+    return result;
+  }
+
+  /// A value inside an array moves the array's index on.
+  void value_done() {
+    if (!frames.empty() && frames.back().array) ++frames.back().index;
+  }
+
+  bool operator()(int /*depth*/, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+        frames.push_back({});
+        break;
+      case Event::array_start:
+        frames.emplace_back();
+        frames.back().array = true;
+        break;
+      case Event::key: {
+        Frame& frame = frames.back();
+        frame.key = parsed.get<std::string>();
+        if (!frame.keys.insert(frame.key).second && duplicate.empty()) duplicate = path();
+        break;
+      }
+      case Event::object_end:
+      case Event::array_end:
+        frames.pop_back();
+        value_done();
+        break;
+      case Event::value:
+        value_done();
+        break;
+    }
+    return true;
+  }
+};
+
 }  // namespace
 
 SceneKeyError::SceneKeyError(const std::string& file, std::string key_path, const std::string& what,
@@ -341,12 +425,24 @@ SceneKeyError::SceneKeyError(const std::string& file, std::string key_path, cons
       m_unknown_key(unknown_key) {}
 
 nlohmann::json read_json_file(const std::filesystem::path& file) {
+  std::error_code error_code;
+  if (std::filesystem::is_directory(file, error_code))
+    throw InputError(file.string() + ": is a folder, not a JSON file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open (no such file or not readable)");
   std::ostringstream text;
   text << in.rdbuf();
   try {
-    return nlohmann::json::parse(text.str());
+    DuplicateKeyCheck duplicates;
+    nlohmann::json root = nlohmann::json::parse(
+        text.str(),
+        [&duplicates](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+          return duplicates(depth, event, parsed);
+        });
+    if (!duplicates.duplicate.empty())
+      throw InputError(file.string() + ": " + duplicates.duplicate +
+                       ": duplicate key (each key may appear once in an object)");
+    return root;
   } catch (const nlohmann::json::parse_error& error) {
     // "[json.exception.parse_error.101] parse error at line 3, column 7: syntax error ..."
     const std::string what = error.what();
@@ -460,7 +556,13 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     }
   }
   scene.solver = parse_solver(top.at("solver"));
-  if (top.has("output")) scene.output = parse_output(top.at("output"));
+  if (top.has("output")) {
+    scene.output = parse_output(top.at("output"));
+    if (scene.output.vtk && !scene.output.vtk_mesh && !scene.mesh.surface) {
+      top.at("output").at("vtk").fail(
+          "\"surface\" writes the fine surface, and the scene has none (mesh.surface)");
+    }
+  }
   if (top.has("hierarchy"))
     scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"), file.parent_path());
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
@@ -479,7 +581,9 @@ Scene load_scene(const std::filesystem::path& file, const std::vector<std::strin
     apply_override(root, parsed.back());
   }
   try {
-    return parse_scene(root, file);
+    Scene scene = parse_scene(root, file);
+    check_input_files(scene);
+    return scene;
   } catch (const SceneKeyError& error) {
     if (!error.unknown_key()) throw;
     for (const SceneOverride& override_ : parsed) {

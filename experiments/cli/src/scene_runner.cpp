@@ -398,6 +398,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   std::ostream& log = options.log ? *options.log : std::cout;
   RunSummary summary;
   summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
+  check_output_folder(summary.output_dir);
 
   PreparedMesh prepared = prepare_scene_mesh(scene);
   const auto [lo, hi] = bounding_box(prepared.mesh.vertices);
@@ -466,7 +467,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   }
   log.flush();
 
-  std::filesystem::create_directories(summary.output_dir);
+  const OutputFolder output_folder(summary.output_dir);
+  ProgressBar progress(options.progress, options.progress_file);
   // A previous run's stats.json would describe this run's outputs if it stopped before writing
   // its own (interrupted): stats.json exists only for a run that ended, and is this run's.
   std::filesystem::remove(summary.output_dir / "stats.json");
@@ -538,7 +540,6 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   save_tables();
   if (options.on_step && scene_simulation.adaptive()) options.on_step(*scene_simulation.adaptive());
   const long total_steps = planned_steps(scene.solver);
-  ProgressBar progress(options.progress, options.progress_file);
   try {
     while (!scene_simulation.finished()) {
       scene_simulation.advance();
@@ -561,8 +562,21 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     progress.clear();
     summary.status = "diverged";
     summary.message = error.what();
+    // A static body that its constraints do not hold has no unique equilibrium: say so.
+    const Simulation& last = scene_simulation.current();
+    const int free_motions =
+        scene.solver.mode == SimulationMode::static_equilibrium && !has_contact
+            ? free_rigid_motions(last.dirichlet_groups(), last.model().rest_positions())
+            : 0;
+    if (free_motions > 0) {
+      summary.message += "; the fixed and prescribed groups leave " + std::to_string(free_motions) +
+                         " rigid motion" + (free_motions > 1 ? "s" : "") +
+                         " of the body free, so a static equilibrium is not unique: hold at "
+                         "least three vertices not on one line (or run it dynamic)";
+    }
     save_tables();
     finish();
+    if (free_motions > 0) throw DivergenceError(summary.message, error.step(), error.time());
     throw;
   }
   progress.clear();

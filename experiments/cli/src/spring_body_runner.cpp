@@ -59,6 +59,7 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   std::ostream& log = options.log ? *options.log : std::cout;
   RunSummary summary;
   summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
+  check_output_folder(summary.output_dir);
   const std::string where = scene.file.string() + ": mesh.surface";
   SurfaceMesh shown;  // the surface as given, drawn and probed
   try {
@@ -147,7 +148,8 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   }
   log.flush();
 
-  std::filesystem::create_directories(summary.output_dir);
+  const OutputFolder output_folder(summary.output_dir);
+  ProgressBar progress(options.progress, options.progress_file);
   std::filesystem::remove(summary.output_dir / "stats.json");  // this run's only, once it ends
   CsvSeries probes(summary.output_dir / "probes.csv", "time,probe,x,y,z,ux,uy,uz");
   ReactionRecorder reactions(summary.output_dir / "reactions.csv");
@@ -283,7 +285,6 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   };
 
   write_frame();
-  ProgressBar progress(options.progress, options.progress_file);
   try {
     while (!run->finished()) {
       run->advance();

@@ -76,6 +76,12 @@ VectorXi dirichlet_owner(const std::vector<DirichletGroup>& groups, Index num_ve
 /// Per-DOF constrained flag (3·#V entries, 1 = prescribed; only the groups' components).
 std::vector<char> dirichlet_dof_mask(const std::vector<DirichletGroup>& groups, Index num_vertices);
 
+/// How many independent rigid motions (of the 3 translations and 3 rotations) the groups leave
+/// free: 0 when the prescribed coordinates pin the body, 3 for a single fixed vertex (it still
+/// turns about it), 1 for fixed vertices on one line. A static run needs 0 unless contact or
+/// balanced loads hold the body. `rest` is 3·#V.
+int free_rigid_motions(const std::vector<DirichletGroup>& groups, ConstRef<VectorXd> rest);
+
 /// Writes the target positions and velocities at time t of all constrained DOFs into `x` and `v`
 /// (3·#V each); free DOFs are left untouched. `rest` is 3·#V. Groups without an amplitude use the
 /// factor `default_s` and its rate `default_rate`.

@@ -13,7 +13,8 @@ class ProgressBar {
  public:
   /// `enabled` false draws nothing (use `stderr_is_terminal() && !quiet`). A non-empty
   /// `file` is rewritten at most twice a second with one line, "<fraction done> <seconds
-  /// elapsed>", whether or not the bar is drawn.
+  /// elapsed>", whether or not the bar is drawn; it is written once at construction ("0 0"),
+  /// which throws InputError if it cannot be (a missing folder, a folder of that name).
   explicit ProgressBar(bool enabled, std::filesystem::path file = {});
   ~ProgressBar();
   ProgressBar(const ProgressBar&) = delete;
@@ -25,7 +26,8 @@ class ProgressBar {
   void clear();
 
  private:
-  void write_file(double fraction, double elapsed);
+  /// Rewrites the file; returns why it could not, or an empty string.
+  std::string write_file(double fraction, double elapsed);
 
   bool m_enabled;
   bool m_drawn = false;

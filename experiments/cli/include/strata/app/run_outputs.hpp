@@ -16,6 +16,26 @@
 
 namespace strata::app {
 
+/// Throws InputError unless `folder` can be an output folder: it is a folder or does not exist
+/// yet, and no part of its path is a file. Creates nothing; a run calls it before its set-up.
+void check_output_folder(const std::filesystem::path& folder);
+
+/// A run's output folder, created and held for the run: a second run into the same folder while
+/// this one holds it is refused (an advisory lock on `.strata.lock` inside it, released when the
+/// run ends, however it ends).
+class OutputFolder {
+ public:
+  /// Creates `folder` if needed and takes it; throws InputError if it cannot be created or
+  /// another run holds it.
+  explicit OutputFolder(const std::filesystem::path& folder);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+
+ private:
+  int m_lock = -1;
+};
+
 /// A CSV file with a header line, rewritten atomically as rows accumulate.
 class CsvSeries {
  public:
