@@ -476,8 +476,19 @@ void AdaptiveSimulation::advance() {
   m_stepping_seconds += seconds_since(start);
   if (adapting() && is_static(m_solver)) {
     // Solve–mark–refine: re-solve the same load factor on each refined cut.
-    for (int pass = 0; pass < m_settings.max_passes && adapting() && adapt(pass, true, false);
-         ++pass) {
+    int passes = 0;
+    for (int pass = 0; pass < m_settings.max_passes && adapting(); ++pass) {
+      bool changed = adapt(pass, true, false);
+      if (!changed && passes == 0 && m_estimates_error && calibration_due()) {
+        // The estimate grew past its last measurement without reaching the tolerance: a pass
+        // against half of it measures it again, where the field changed.
+        m_calibration_target = kCalibrationFraction * m_estimate.relative_error;
+        changed = adapt(pass, true, false);
+        m_calibration_target = 0.0;
+        if (changed) ++m_report.calibration_passes;
+      }
+      if (!changed) break;
+      ++passes;
       const auto solve_start = Clock::now();
       const double refined_estimate = m_estimate.relative_error;  // of the cut before the pass
       const VectorXd carried = m_simulation->positions();
@@ -488,6 +499,7 @@ void AdaptiveSimulation::advance() {
       m_stepping_seconds += seconds_since(solve_start);
       if (m_estimates_error) measure_estimate(refined_estimate, carried);
     }
+    if (passes > 0 && m_estimates_error) m_calibrated_estimate = estimate_error().relative_error;
   }
   m_load_step_start.resize(0);
   record_contact_step();
@@ -593,9 +605,13 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
   state.recovery_estimate = &m_estimate;
-  // An error-estimating indicator refines only while the run's estimate exceeds the tolerance.
+  // An error-estimating indicator refines only while the run's estimate exceeds the tolerance
+  // (a calibration pass: its target).
   const bool within_tolerance =
-      m_estimates_error && m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
+      m_calibration_target <= 0.0 && m_estimates_error &&
+      m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
+  if (m_calibration_target > 0.0)
+    state.tolerance_scale = m_settings.tolerance / m_calibration_target;
   if (!coarsen && (!refine || within_tolerance)) return {};
   fields = sim.model().tet_fields(sim.positions());
   // No merges while a load with an amplitude is still growing: the estimate of the current state
@@ -891,6 +907,13 @@ void AdaptiveSimulation::record_sample() {
     if (sample.estimated_error > m_settings.tolerance) ++m_report.steps_over_tolerance;
   }
   m_history.push_back(sample);
+}
+
+bool AdaptiveSimulation::calibration_due() const {
+  if (!m_estimate_valid) return false;
+  const double estimate = m_estimate.relative_error;
+  return estimate > kCalibrationGrowth * m_calibrated_estimate &&
+         m_estimate_scale * estimate > kCalibrationFloor * m_settings.tolerance;
 }
 
 void AdaptiveSimulation::measure_estimate(double refined_estimate, const VectorXd& carried) {

@@ -236,6 +236,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
   block["estimate_scale"] = report.estimate_scale;
   block["refused_refinements"] = report.refused_refinements;
   block["redone_steps"] = report.redone_steps;
+  block["calibration_passes"] = report.calibration_passes;
   block["redo_seconds"] = report.redo_seconds;
   block["initial_refinements"] = report.initial_refinements;
   block["initial_passes"] = report.initial_passes;

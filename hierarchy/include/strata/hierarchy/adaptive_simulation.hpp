@@ -184,6 +184,7 @@ struct ToleranceReport {
   /// step veto, hysteresis) over the run.
   long refused_refinements = 0;
   long redone_steps = 0;               ///< redo passes: dynamic steps redone on a refined cut
+  long calibration_passes = 0;         ///< static: passes made to measure a grown estimate again
   double redo_seconds = 0.0;           ///< wall time of the discarded attempts [s]
   int initial_refinements = 0;         ///< nodes refined by the initial adaptation
   int initial_passes = 0;              ///< static solves of the initial adaptation
@@ -314,6 +315,19 @@ class AdaptiveSimulation final : public SimulationRun {
   /// stands, 1 when it is within the estimate).
   void measure_estimate(double refined_estimate, const VectorXd& carried);
   double m_estimate_scale = 1.0;
+  /// Static runs: the estimate of the cut a load step's passes ended on (0 before any pass). A
+  /// later load step whose estimate exceeds it kCalibrationGrowth-fold, while within the
+  /// tolerance, makes one calibration pass: refinement against kCalibrationFraction of its
+  /// estimate, re-solved and measured like any pass (a load that starts late, or grows
+  /// elsewhere than the passes saw, changes how far the estimate reads the error).
+  double m_calibrated_estimate = 0.0;
+  /// While positive, the target a decision refines against instead of the tolerance.
+  double m_calibration_target = 0.0;
+  static constexpr double kCalibrationGrowth = 1.25;
+  static constexpr double kCalibrationFraction = 0.5;
+  /// Estimates below this fraction of the tolerance (scaled) are not measured again.
+  static constexpr double kCalibrationFloor = 0.1;
+  bool calibration_due() const;
   /// Explicit integrators: whether solver.dt is within the stable-step estimate of the tree's
   /// finest level (computed once), so that the run may go on at full resolution.
   bool finest_level_stable() const;
