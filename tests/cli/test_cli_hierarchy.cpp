@@ -268,6 +268,23 @@ TEST(CliHierarchy, AStaticRunWhosePassesOutgrowTheEstimateRefinesOn) {
   const json stats = read_json(folder.path() / "adaptive" / "stats.json");
   EXPECT_GT(stats["hierarchy"]["estimate_scale"].get<double>(), 2.0);
   EXPECT_LE(error / scale, 0.01);
+  // At τ = 5 % the roots' estimate (1.7 %) is within the tolerance from the first load step, so
+  // no regular pass measures it: a calibration pass must, or the run stays on the roots, 48 %
+  // off.
+  const CliResult loose =
+      run_strata("run rod.json --quiet --set hierarchy.tolerance=0.05 --out loose", folder.path());
+  ASSERT_EQ(loose.exit_code, 0) << loose.err;
+  const Csv run = read_csv(folder.path() / "loose" / "probes.csv");
+  ASSERT_EQ(full.rows.size(), run.rows.size());
+  double loose_error = 0.0;
+  for (size_t r = 0; r < full.rows.size(); ++r) {
+    const Vector3d u(full.rows[r][5], full.rows[r][6], full.rows[r][7]);
+    const Vector3d v(run.rows[r][5], run.rows[r][6], run.rows[r][7]);
+    loose_error = std::max(loose_error, (u - v).norm());
+  }
+  const json loose_stats = read_json(folder.path() / "loose" / "stats.json");
+  EXPECT_GE(loose_stats["hierarchy"]["calibration_passes"].get<int>(), 1);
+  EXPECT_LE(loose_error / scale, 0.05);
 }
 
 TEST(CliHierarchy, AStaticRunMeasuresItsEstimateAgainWhenALoadStartsLate) {
@@ -310,6 +327,19 @@ TEST(CliHierarchy, AStaticRunMeasuresItsEstimateAgainWhenALoadStartsLate) {
   const json stats = read_json(folder.path() / "adaptive" / "stats.json");
   EXPECT_GE(stats["hierarchy"]["calibration_passes"].get<int>(), 1);
   EXPECT_LE(error / scale, 0.01);
+  // Proportional loading moves no share of the estimate: after the first load step's passes,
+  // no calibration pass and no further cut change.
+  json proportional = scene;
+  proportional["forces"].erase(1);
+  proportional["forces"][0].erase("amplitude");
+  write_text(folder.path() / "proportional.json", proportional.dump(2));
+  const CliResult result = run_strata("run proportional.json --quiet --out p", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json steady = read_json(folder.path() / "p" / "stats.json")["hierarchy"];
+  EXPECT_EQ(steady["calibration_passes"].get<int>(), 0);
+  ASSERT_FALSE(steady["changes"].empty());
+  for (const json& change : steady["changes"])
+    EXPECT_EQ(change["step"].get<int>(), 1);
 }
 
 TEST(CliHierarchy, BadToleranceNamesTheKey) {

@@ -78,9 +78,9 @@ int SceneValue::integer(int min_value) const {
   if (!m_value.is_number()) fail("must be an integer, got " + type_name(m_value));
   const double value = m_value.get<double>();
   if (value != std::floor(value)) fail("must be an integer");
-  if (std::abs(value) > std::numeric_limits<int>::max())
-    fail("must be an integer of at most " + std::to_string(std::numeric_limits<int>::max()));
   if (value < min_value) fail("must be >= " + std::to_string(min_value));
+  if (value > std::numeric_limits<int>::max())
+    fail("must be an integer of at most " + std::to_string(std::numeric_limits<int>::max()));
   return static_cast<int>(value);
 }
 

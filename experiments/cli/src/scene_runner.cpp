@@ -564,11 +564,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     summary.status = "diverged";
     summary.message = error.what();
     // A static body that its constraints do not hold has no unique equilibrium: say so.
-    const Simulation& last = scene_simulation.current();
-    const int free_motions =
-        scene.solver.mode == SimulationMode::static_equilibrium && !has_contact
-            ? free_rigid_motions(last.dirichlet_groups(), last.model().rest_positions())
-            : 0;
+    int free_motions = 0;
+    if (scene.solver.mode == SimulationMode::static_equilibrium && !has_contact) {
+      try {
+        const Simulation& last = scene_simulation.current();
+        free_motions = free_rigid_motions(last.dirichlet_groups(), last.model().rest_positions());
+      } catch (const std::logic_error&) {
+        // a failed cut change left no Simulation to ask
+      }
+    }
     if (free_motions > 0) {
       summary.message += "; the fixed and prescribed groups leave " + std::to_string(free_motions) +
                          " rigid motion" + (free_motions > 1 ? "s" : "") +

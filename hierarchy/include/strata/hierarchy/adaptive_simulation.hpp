@@ -315,18 +315,23 @@ class AdaptiveSimulation final : public SimulationRun {
   /// stands, 1 when it is within the estimate).
   void measure_estimate(double refined_estimate, const VectorXd& carried);
   double m_estimate_scale = 1.0;
-  /// Static runs: the estimate of the cut a load step's passes ended on (0 before any pass). A
-  /// later load step whose estimate exceeds it kCalibrationGrowth-fold, while within the
-  /// tolerance, makes one calibration pass: refinement against kCalibrationFraction of its
-  /// estimate, re-solved and measured like any pass (a load that starts late, or grows
-  /// elsewhere than the passes saw, changes how far the estimate reads the error).
-  double m_calibrated_estimate = 0.0;
+  /// Static runs: each active tet's share of the estimate (η_t,full² / ‖u‖_E², per flat tet) on
+  /// the cut a load step's passes ended on, or on a cut no pass has measured yet; empty after a
+  /// cut change. When the shares that grew since then add up to more than (kCalibrationGrowth² − 1)
+  /// of their total, on a later load step within the tolerance, the run makes one calibration
+  /// pass: refinement against kCalibrationFraction of its estimate, re-solved and measured like
+  /// any pass (a load that starts late, or grows elsewhere than the passes saw, changes how far
+  /// the estimate reads the error). A load step within the tolerance before any pass has
+  /// measured the estimate makes one as well.
+  VectorXd m_calibrated_shares;
+  bool m_estimate_measured = false;  ///< whether a pass has measured the estimate (static runs)
   /// While positive, the target a decision refines against instead of the tolerance.
   double m_calibration_target = 0.0;
   static constexpr double kCalibrationGrowth = 1.25;
   static constexpr double kCalibrationFraction = 0.5;
   /// Estimates below this fraction of the tolerance (scaled) are not measured again.
   static constexpr double kCalibrationFloor = 0.1;
+  static VectorXd error_shares(const RecoveryEstimate& estimate);
   bool calibration_due() const;
   /// Explicit integrators: whether solver.dt is within the stable-step estimate of the tree's
   /// finest level (computed once), so that the run may go on at full resolution.
