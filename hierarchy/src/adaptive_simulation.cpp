@@ -261,6 +261,11 @@ void AdaptiveSimulation::initial_adaptation() {
   // obstacles every pass starts from rest (a carried state may start inside an obstacle).
   std::unique_ptr<FlatTreeMesh> previous_flat;
   VectorXd previous_positions;
+  // A first cut within the tolerance has an estimate no pass measured: one calibration pass
+  // refines against a fraction of it, and the next pass's solve measures it (as in static runs).
+  std::unique_ptr<FlatTreeMesh> calibration_flat;
+  VectorXd calibration_positions;
+  double calibration_estimate = 0.0;
   for (int pass = 0; pass < m_settings.max_passes && !all_at_level(*m_cut, max_refine_level());
        ++pass) {
     SimulationOptions options = flatten(0);
@@ -301,6 +306,12 @@ void AdaptiveSimulation::initial_adaptation() {
     }
     ++m_report.initial_passes;
     m_report.initial_newton_iterations += solve->counters().newton_iterations;
+    if (calibration_flat) {
+      const VectorXd carried = transfer_vertex_values(*m_tree, *calibration_flat,
+                                                      calibration_positions, m_constrained->flat);
+      measure_estimate(calibration_estimate, solve->positions(), carried);
+      calibration_flat.reset();
+    }
     m_mesh_external += gravity_forces(solve->vertex_mass(), m_gravity);
     const TetFields fields = solve->model().tet_fields(solve->positions());
     const VectorXd loads = criteria_loads(*solve);
@@ -308,13 +319,28 @@ void AdaptiveSimulation::initial_adaptation() {
                    loads,           solve->vertex_mass(), m_material,         0,
                    &m_load_traction};
     state.solution_energy_scale = m_energy_floor;
+    state.tolerance_scale = m_estimate_scale;
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
-    if (m_estimates_error && estimate.relative_error <= m_settings.tolerance) break;
+    const double scaled = m_estimate_scale * estimate.relative_error;
+    bool calibrate = false;
+    if (m_estimates_error && scaled <= m_settings.tolerance) {
+      calibrate =
+          pass == 0 && !m_estimate_measured && scaled > kCalibrationFloor * m_settings.tolerance;
+      if (!calibrate) break;
+      state.tolerance_scale =
+          m_settings.tolerance / (kCalibrationFraction * estimate.relative_error);
+    }
     m_decision_merges = false;
     const CutChanges changes = m_controller->decide(state, *m_cut);
     m_report.refused_refinements += changes.refused;
     if (changes.refine.empty()) break;
+    if (calibrate) {
+      ++m_report.calibration_passes;
+      calibration_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
+      calibration_positions = solve->positions();
+      calibration_estimate = estimate.relative_error;
+    }
     if (m_obstacles.empty()) {
       previous_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
       previous_positions = solve->positions();
@@ -502,7 +528,7 @@ void AdaptiveSimulation::advance() {
               ? m_constrained->constraints.restrict_to_free(m_load_step_start)
               : VectorXd());
       m_stepping_seconds += seconds_since(solve_start);
-      if (m_estimates_error) measure_estimate(refined_estimate, carried);
+      if (m_estimates_error) measure_estimate(refined_estimate, m_simulation->positions(), carried);
     }
     // The baseline of the next calibration: the cut the passes ended on, or a cut no pass has
     // measured yet (the first load step's, or one the merges between load steps changed).
@@ -941,11 +967,11 @@ bool AdaptiveSimulation::calibration_due() const {
   return grown.sum() > (kCalibrationGrowth * kCalibrationGrowth - 1.0) * measured;
 }
 
-void AdaptiveSimulation::measure_estimate(double refined_estimate, const VectorXd& carried) {
+void AdaptiveSimulation::measure_estimate(double refined_estimate, const VectorXd& solved,
+                                          const VectorXd& carried) {
   // The pass carried the previous cut's equilibrium to the refined cut (the same field) and
   // solved again: the largest vertex displacement it changed, relative to the largest
   // displacement, is a lower bound of the previous cut's error in the measure of the tolerance.
-  const VectorXd& solved = m_simulation->positions();
   const MatrixX3d& rest = m_constrained->flat.mesh.vertices;
   double largest = 0.0, change = 0.0;
   for (Index v = 0; v < rest.rows(); ++v) {

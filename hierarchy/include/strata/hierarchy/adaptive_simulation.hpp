@@ -307,13 +307,14 @@ class AdaptiveSimulation final : public SimulationRun {
   /// Whether solver.dt is within the stable-step estimate of `tets` (Bey-ordered positions) as a
   /// mesh of their own.
   bool stable_on_their_own(const std::vector<Matrix3x4d>& tets) const;
-  /// Static runs, after a refinement pass re-solved its load step: the pass's change (largest
-  /// vertex displacement difference between the carried state `carried` and the new
-  /// equilibrium, relative to the largest displacement) bounds the refined cut's error from
+  /// Static runs after a refinement pass re-solved its load step, and a dynamic run's initial
+  /// adaptation after its calibration pass: the pass's change (largest vertex displacement
+  /// difference between the carried state `carried` and the new equilibrium `solved`, relative
+  /// to the largest displacement) bounds the refined cut's error from
   /// below; where it exceeds that cut's estimate `refined_estimate`, their ratio scales the
   /// estimate of every later decision and sample (m_estimate_scale; the latest measurement
   /// stands, 1 when it is within the estimate).
-  void measure_estimate(double refined_estimate, const VectorXd& carried);
+  void measure_estimate(double refined_estimate, const VectorXd& solved, const VectorXd& carried);
   double m_estimate_scale = 1.0;
   /// Static runs: each active tet's share of the estimate (η_t,full² / ‖u‖_E², per flat tet) on
   /// the cut a load step's passes ended on, or on a cut no pass has measured yet; empty after a
