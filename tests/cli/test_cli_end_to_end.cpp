@@ -499,6 +499,28 @@ TEST(CliEndToEnd, DuplicateKeysFoldersAndFilesAreNamedInTheError) {
                  "scene.json: mesh.box.cells.0: must be an integer of at most 2147483647");
 }
 
+TEST(CliEndToEnd, KeysTheRunDoesNotUseAreWarnedAbout) {
+  TempFolder folder;
+  json scene = bar_scene();  // static
+  scene["solver"]["dt"] = 0.01;
+  write_scene(folder, scene);
+  CliResult result = run_strata("run scene.json -q", folder.path());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.err,
+            "strata: warning: scene.json: solver.dt: applies to dynamic runs only (ignored)\n");
+  scene = bar_scene();
+  scene["solver"] =
+      json::parse(R"({"mode": "dynamic", "dt": 0.01, "duration": 0.01, "load_steps": 4})");
+  scene["hierarchy"] = {{"levels", 1}, {"mode", "full"}, {"level", 0}};
+  write_scene(folder, scene);
+  result = run_strata("run scene.json -q", folder.path());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.err,
+            "strata: warning: scene.json: solver.load_steps: applies to static runs only "
+            "(ignored)\nstrata: warning: scene.json: hierarchy.level: mode \"full\" runs on the "
+            "finest level (ignored)\n");
+}
+
 TEST(CliEndToEnd, OutputFolderAndProgressFileProblemsAreBadInput) {
   TempFolder folder;
   write_scene(folder, bar_scene());

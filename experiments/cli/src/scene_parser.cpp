@@ -556,6 +556,16 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     }
   }
   scene.solver = parse_solver(top.at("solver"));
+  {
+    const SceneValue solver = top.at("solver");
+    const bool dynamic = scene.solver.mode == SimulationMode::dynamic;
+    for (const char* key : {"integrator", "dt", "duration"})
+      if (!dynamic && solver.has(key))
+        scene.ignored_keys.push_back(std::string("solver.") + key +
+                                     ": applies to dynamic runs only (ignored)");
+    if (dynamic && solver.has("load_steps"))
+      scene.ignored_keys.push_back("solver.load_steps: applies to static runs only (ignored)");
+  }
   if (top.has("output")) {
     scene.output = parse_output(top.at("output"));
     if (scene.output.vtk && !scene.output.vtk_mesh && !scene.mesh.surface) {
@@ -565,6 +575,10 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   }
   if (top.has("hierarchy"))
     scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"), file.parent_path());
+  if (scene.hierarchy && scene.hierarchy->mode == HierarchyMode::full &&
+      top.at("hierarchy").has("level"))
+    scene.ignored_keys.push_back(
+        "hierarchy.level: mode \"full\" runs on the finest level (ignored)");
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {
     throw SceneKeyError(file_name, "fixed",

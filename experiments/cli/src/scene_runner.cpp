@@ -400,6 +400,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   RunSummary summary;
   summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
   check_output_folder(summary.output_dir);
+  for (const std::string& ignored : scene.ignored_keys)
+    std::cerr << "strata: warning: " << scene.file.string() << ": " << ignored << "\n";
 
   PreparedMesh prepared = prepare_scene_mesh(scene);
   const auto [lo, hi] = bounding_box(prepared.mesh.vertices);

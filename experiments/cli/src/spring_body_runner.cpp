@@ -60,6 +60,8 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
   RunSummary summary;
   summary.output_dir = options.output_dir.empty() ? default_output_dir(scene) : options.output_dir;
   check_output_folder(summary.output_dir);
+  for (const std::string& ignored : scene.ignored_keys)
+    std::cerr << "strata: warning: " << scene.file.string() << ": " << ignored << "\n";
   const std::string where = scene.file.string() + ": mesh.surface";
   SurfaceMesh shown;  // the surface as given, drawn and probed
   try {

@@ -101,6 +101,9 @@ struct Scene {
   std::optional<HierarchySettings> hierarchy;
   std::vector<ObstacleSpec> obstacles;
   BodySpec body;
+  /// Keys the scene gives that its run does not use ("solver.load_steps: applies to static runs
+  /// only (ignored)"); the runner prints each as a warning.
+  std::vector<std::string> ignored_keys;
 
   /// fixed groups first, then prescribed ones: the order of reactions.csv's `group` column.
   std::vector<DirichletSpec> dirichlet_groups() const;
