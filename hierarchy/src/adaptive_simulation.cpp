@@ -610,16 +610,27 @@ VectorXd AdaptiveSimulation::criteria_loads(const Simulation& simulation) {
 }
 
 bool AdaptiveSimulation::load_grows_before_next_decision() const {
-  // A merge made now stands until the next coarsening decision: adapt_every steps on (dynamic);
-  // through the next load step, whose solve starts on the merged cut (static: t is the load
-  // factor).
+  // A merge made now stands until the next coarsening decision (adapt_every steps on; static
+  // runs: the next load step, whose solve starts on the merged cut), and a merged node may not
+  // be refined again for min_steps_between_changes steps: the horizon is the longer of the two
+  // (t is the load factor in static runs).
   const double t = time();
-  const double horizon = is_static(m_solver) ? 1.0 / static_cast<double>(m_solver.load_steps)
-                                             : m_settings.adapt_every * m_solver.dt;
+  const long steps = std::max<long>(is_static(m_solver) ? 1 : m_settings.adapt_every,
+                                    m_settings.criteria.min_steps_between_changes);
+  const double horizon =
+      static_cast<double>(steps) *
+      (is_static(m_solver) ? 1.0 / static_cast<double>(m_solver.load_steps) : m_solver.dt);
   // A plateau's interpolated values differ from the table's in the last bits: growth is a rise
-  // beyond round-off of the load's peak.
+  // beyond round-off of the amplitude's peak.
+  const auto grows = [&](const Amplitude& amplitude) {
+    return amplitude.peak(t, t + horizon) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak();
+  };
   for (const auto& [amplitude, point_loads] : m_timed_point_loads)
-    if (amplitude.peak(t, t + horizon) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak())
+    if (grows(amplitude)) return true;
+  // Prescribed motions on an amplitude table likewise (fixed groups do not move; groups on the
+  // run's default ramp grow in proportion from the start).
+  for (const DirichletSpec& group : m_dirichlet)
+    if (group.kind != DirichletKind::fixed && !group.amplitude.empty() && grows(group.amplitude))
       return true;
   return false;
 }

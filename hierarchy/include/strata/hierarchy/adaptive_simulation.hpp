@@ -393,9 +393,10 @@ class AdaptiveSimulation final : public SimulationRun {
   /// step (mesh positions of the current cut, carried with each change), from which friction in
   /// a re-solve measures slip; empty otherwise.
   VectorXd m_load_step_start;
-  /// Whether a load with an amplitude grows before the next coarsening decision: its largest
-  /// magnitude over the next adapt_every steps (dynamic) or the next load step (static) exceeds
-  /// its magnitude now.
+  /// Whether a load or a prescribed motion with an amplitude grows before a merge made now could
+  /// be undone: its largest magnitude over the next max(adapt_every, min_steps_between_changes)
+  /// steps (dynamic) or max(1, min_steps_between_changes) load steps (static) exceeds its
+  /// magnitude now.
   bool load_grows_before_next_decision() const;
   std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
   /// Loads with an amplitude, each on the finest level.
