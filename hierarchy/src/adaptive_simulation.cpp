@@ -266,6 +266,17 @@ void AdaptiveSimulation::initial_adaptation() {
   std::unique_ptr<FlatTreeMesh> calibration_flat;
   VectorXd calibration_positions;
   double calibration_estimate = 0.0;
+  // The static response at full load: loads with an amplitude at their peak (peak_loads), and
+  // prescribed motions with one at the value of largest magnitude in their table (the static
+  // solve's load factor 1 would read the table at t = 1).
+  std::vector<DirichletSpec> peak_dirichlet = m_dirichlet;
+  for (DirichletSpec& group : peak_dirichlet) {
+    if (group.amplitude.empty()) continue;
+    std::array<double, 2> largest = group.amplitude.points.front();
+    for (const std::array<double, 2>& point : group.amplitude.points)
+      if (std::abs(point[1]) > std::abs(largest[1])) largest = point;
+    group.amplitude.points = {{0.0, largest[1]}};
+  }
   for (int pass = 0; pass < m_settings.max_passes && !all_at_level(*m_cut, max_refine_level());
        ++pass) {
     SimulationOptions options = flatten(0);
@@ -276,9 +287,9 @@ void AdaptiveSimulation::initial_adaptation() {
     options.extra_mesh_forces = m_mesh_external;
     options.extra_timed_mesh_forces.clear();
     const auto static_solve = [&](bool warm) {
-      auto solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
-                                                std::vector<RegionLoad>{}, m_ground, m_gravity,
-                                                statics, options);
+      auto solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material,
+                                                peak_dirichlet, std::vector<RegionLoad>{}, m_ground,
+                                                m_gravity, statics, options);
       if (warm) {
         const HangingConstraints& constraints = m_constrained->constraints;
         const VectorXd q = constraints.restrict_to_free(transfer_vertex_values(

@@ -376,6 +376,31 @@ TEST(CliHierarchy, NoMergeMeetsAPrescribedMotionAboutToStart) {
   }
 }
 
+TEST(CliHierarchy, TheInitialAdaptationSeesAPrescribedMotionAtItsPeak) {
+  // A bar clamped at one end whose other end is shaken up and down by an amplitude table that
+  // ends at rest: the initial adaptation's static solve at load factor 1 read the table at
+  // t = 1 (0, no motion) and started the run on the roots. At the table's peak it refines.
+  const TempFolder folder;
+  const json scene = json::parse(R"({
+    "mesh": {"box": {"min": [0, 0, 0], "max": [0.2, 0.05, 0.05], "cells": [8, 2, 2]}},
+    "material": {"model": "neohookean", "youngs_modulus": 1e5, "poisson_ratio": 0.3,
+                 "density": 1000},
+    "fixed": [{"plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}}],
+    "prescribed": [{"region": {"plane": {"point": [0.2, 0, 0], "normal": [1, 0, 0]}},
+                    "displacement": [0, 0, 0.01],
+                    "amplitude": [[0, 0], [0.025, 1], [0.05, 0], [0.075, -1], [0.1, 0]]}],
+    "solver": {"mode": "dynamic", "integrator": "implicit_euler", "dt": 0.001, "duration": 0.005},
+    "output": {"vtk": false, "probes": [[0.1, 0.025, 0.025]]},
+    "hierarchy": {"levels": 2}
+  })");
+  write_text(folder.path() / "shaken.json", scene.dump(2));
+  const CliResult result = run_strata("run shaken.json --quiet --out out", folder.path());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json stats = read_json(folder.path() / "out" / "stats.json")["hierarchy"];
+  EXPECT_GT(stats["initial_refinements"].get<int>(), 0);
+  EXPECT_GT(stats["history"]["tets"][0].get<int>(), stats["root_tets"].get<int>());
+}
+
 TEST(CliHierarchy, AStaticRunMeasuresItsEstimateAgainWhenALoadStartsLate) {
   // A block (0.4 × 0.4 × 0.2 m, 7 × 7 × 3 cells, two levels) on its base: a top patch load rises
   // to λ = 0.5 and falls, and a side patch load starts at λ = 0.5. The first load step's passes
