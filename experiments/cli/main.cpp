@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,20 +27,26 @@ constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;
 constexpr int kExitDiverged = 3;
 
+/// `text` read whole by `parse` (std::stol, std::stod), or nothing.
+template <typename T, typename Parse>
+std::optional<T> read_whole(const std::string& text, Parse parse) {
+  try {
+    std::size_t used = 0;
+    const T value = parse(text, &used);
+    if (!text.empty() && used == text.size()) return value;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
 /// A whole number in [minimum, maximum]; the message quotes the bounds as integers.
 CLI::Validator whole_number(long minimum, long maximum) {
   return CLI::Validator(
       [minimum, maximum](std::string& text) -> std::string {
-        long value = 0;
-        std::size_t used = 0;
-        try {
-          value = std::stol(text, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (text.empty() || used != text.size())
-          return "expected a whole number, got '" + text + "'";
-        if (value < minimum || value > maximum)
+        const std::optional<long> value = read_whole<long>(
+            text, [](const std::string& t, std::size_t* used) { return std::stol(t, used); });
+        if (!value) return "expected a whole number, got '" + text + "'";
+        if (*value < minimum || *value > maximum)
           return "must be between " + std::to_string(minimum) + " and " + std::to_string(maximum) +
                  ", got " + text;
         return {};
@@ -51,15 +58,10 @@ CLI::Validator whole_number(long minimum, long maximum) {
 CLI::Validator open_unit_interval() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        double value = 0.0;
-        std::size_t used = 0;
-        try {
-          value = std::stod(text, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (text.empty() || used != text.size()) return "expected a number, got '" + text + "'";
-        if (!(value > 0.0 && value < 1.0)) return "must be in (0, 1), got " + text;
+        const std::optional<double> value = read_whole<double>(
+            text, [](const std::string& t, std::size_t* used) { return std::stod(t, used); });
+        if (!value) return "expected a number, got '" + text + "'";
+        if (!(*value > 0.0 && *value < 1.0)) return "must be in (0, 1), got " + text;
         return {};
       },
       "in (0, 1)");

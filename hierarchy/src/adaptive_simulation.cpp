@@ -262,9 +262,8 @@ void AdaptiveSimulation::initial_adaptation() {
   std::unique_ptr<FlatTreeMesh> previous_flat;
   VectorXd previous_positions;
   // A first cut within the tolerance has an estimate no pass measured: one calibration pass
-  // refines against a fraction of it, and the next pass's solve measures it (as in static runs).
-  std::unique_ptr<FlatTreeMesh> calibration_flat;
-  VectorXd calibration_positions;
+  // refines against a fraction of it, and the next pass's solve measures it against the
+  // previous response (as in static runs). 0: no measurement due.
   double calibration_estimate = 0.0;
   // The static response at full load: loads with an amplitude at their peak (peak_loads), and
   // prescribed motions with one at the value of largest magnitude in their table (the static
@@ -300,11 +299,12 @@ void AdaptiveSimulation::initial_adaptation() {
       return solve;
     };
     std::unique_ptr<Simulation> solve;
+    const bool warm = previous_flat != nullptr && m_obstacles.empty();
     try {
-      solve = static_solve(previous_flat != nullptr);
+      solve = static_solve(warm);
     } catch (const DivergenceError&) {
       // Newton could not bring the carried start to equilibrium: the same solve from rest.
-      if (previous_flat) {
+      if (warm) {
         try {
           solve = static_solve(false);
         } catch (const DivergenceError&) {
@@ -317,11 +317,11 @@ void AdaptiveSimulation::initial_adaptation() {
     }
     ++m_report.initial_passes;
     m_report.initial_newton_iterations += solve->counters().newton_iterations;
-    if (calibration_flat) {
-      const VectorXd carried = transfer_vertex_values(*m_tree, *calibration_flat,
-                                                      calibration_positions, m_constrained->flat);
+    if (calibration_estimate > 0.0) {
+      const VectorXd carried =
+          transfer_vertex_values(*m_tree, *previous_flat, previous_positions, m_constrained->flat);
       measure_estimate(calibration_estimate, solve->positions(), carried);
-      calibration_flat.reset();
+      calibration_estimate = 0.0;
     }
     m_mesh_external += gravity_forces(solve->vertex_mass(), m_gravity);
     const TetFields fields = solve->model().tet_fields(solve->positions());
@@ -348,11 +348,9 @@ void AdaptiveSimulation::initial_adaptation() {
     if (changes.refine.empty()) break;
     if (calibrate) {
       ++m_report.calibration_passes;
-      calibration_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
-      calibration_positions = solve->positions();
       calibration_estimate = estimate.relative_error;
     }
-    if (m_obstacles.empty()) {
+    if (m_obstacles.empty() || calibrate) {
       previous_flat = std::make_unique<FlatTreeMesh>(m_constrained->flat);
       previous_positions = solve->positions();
     }
@@ -519,14 +517,7 @@ void AdaptiveSimulation::advance() {
       if (!changed && passes == 0 && m_estimates_error && calibration_due()) {
         // The estimate's distribution over the cut grew past its last measurement without
         // reaching the tolerance: a pass against a fraction of it measures it again.
-        m_calibration_target = kCalibrationFraction * m_estimate.relative_error;
-        try {
-          changed = adapt(pass, true, false);
-        } catch (...) {
-          m_calibration_target = 0.0;
-          throw;
-        }
-        m_calibration_target = 0.0;
+        changed = adapt(pass, true, false, kCalibrationFraction * m_estimate.relative_error);
         if (changed) ++m_report.calibration_passes;
       }
       if (!changed) break;
@@ -646,7 +637,7 @@ bool AdaptiveSimulation::load_grows_before_next_decision() const {
   return false;
 }
 
-CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
+CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibration_target) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
   // The estimate needs the strains only; the stresses follow when the decision goes on to the
@@ -664,10 +655,9 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   // An error-estimating indicator refines only while the run's estimate exceeds the tolerance
   // (a calibration pass: its target).
   const bool within_tolerance =
-      m_calibration_target <= 0.0 && m_estimates_error &&
+      calibration_target <= 0.0 && m_estimates_error &&
       m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
-  if (m_calibration_target > 0.0)
-    state.tolerance_scale = m_settings.tolerance / m_calibration_target;
+  if (calibration_target > 0.0) state.tolerance_scale = m_settings.tolerance / calibration_target;
   if (!coarsen && (!refine || within_tolerance)) return {};
   fields = sim.model().tet_fields(sim.positions());
   // No merges while a load with an amplitude is still growing: the estimate of the current state
@@ -683,9 +673,9 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen) {
   return changes;
 }
 
-bool AdaptiveSimulation::adapt(int pass, bool refine, bool coarsen) {
+bool AdaptiveSimulation::adapt(int pass, bool refine, bool coarsen, double calibration_target) {
   const auto start = Clock::now();
-  const CutChanges changes = decide(refine, coarsen);
+  const CutChanges changes = decide(refine, coarsen, calibration_target);
   if (changes.refine.empty() && changes.coarsen.empty()) {
     m_bookkeeping_seconds += seconds_since(start);
     return false;

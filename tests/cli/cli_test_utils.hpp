@@ -5,6 +5,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -89,6 +91,27 @@ inline Csv read_csv(const std::filesystem::path& path) {
     csv.rows.push_back(row);
   }
   return csv;
+}
+
+/// The largest probe-displacement difference of the run in folder `run` to the one in
+/// `reference` (their probes.csv, row for row) over every frame and probe, relative to the
+/// largest reference displacement: the error measure of `hierarchy.tolerance`.
+inline double probe_error(const std::filesystem::path& run,
+                          const std::filesystem::path& reference) {
+  const Csv a = read_csv(run / "probes.csv");
+  const Csv b = read_csv(reference / "probes.csv");
+  EXPECT_EQ(a.rows.size(), b.rows.size()) << run << " against " << reference;
+  double difference = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < std::min(a.rows.size(), b.rows.size()); ++i) {
+    double d = 0.0, s = 0.0;
+    for (int k = 5; k < 8; ++k) {
+      d += (a.rows[i][k] - b.rows[i][k]) * (a.rows[i][k] - b.rows[i][k]);
+      s += b.rows[i][k] * b.rows[i][k];
+    }
+    difference = std::max(difference, std::sqrt(d));
+    scale = std::max(scale, std::sqrt(s));
+  }
+  return difference / scale;
 }
 
 inline nlohmann::json read_json(const std::filesystem::path& path) {

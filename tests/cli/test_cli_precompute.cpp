@@ -34,25 +34,6 @@ json slab(double patch_x) {
   return scene;
 }
 
-/// Largest probe-displacement difference to `reference` over every frame and probe, relative to
-/// the largest reference displacement.
-double probe_error(const std::filesystem::path& run, const std::filesystem::path& reference) {
-  const Csv a = read_csv(run / "probes.csv");
-  const Csv b = read_csv(reference / "probes.csv");
-  EXPECT_EQ(a.rows.size(), b.rows.size());
-  double difference = 0.0, scale = 0.0;
-  for (std::size_t i = 0; i < std::min(a.rows.size(), b.rows.size()); ++i) {
-    double d = 0.0, s = 0.0;
-    for (int k = 5; k < 8; ++k) {
-      d += std::pow(a.rows[i][k] - b.rows[i][k], 2);
-      s += std::pow(b.rows[i][k], 2);
-    }
-    difference = std::max(difference, std::sqrt(d));
-    scale = std::max(scale, std::sqrt(s));
-  }
-  return difference / scale;
-}
-
 CliResult run_in(const TempFolder& folder, const std::string& arguments) {
   return run_strata(arguments, folder.path());
 }

@@ -43,11 +43,13 @@ void run_precompute_command(const PrecomputeCommand& command, std::ostream& log)
   if (command.output.extension() != ".json")
     throw InputError("precompute: --out " + command.output.string() + ": must be a .json file");
   if (!command.mesh.empty()) mesh_format_of(command.mesh);  // unknown extensions fail early
-  // A window holds at least one step (or load step) of the longest run.
+  // The scenes as written, to read their own tolerances; a window holds at least one step (or
+  // load step) of the longest run.
+  std::vector<Scene> originals;
   long longest = 0;
   for (const std::filesystem::path& file : command.scenes) {
-    const Scene scene = load_scene(file, command.overrides);
-    longest = std::max(longest, planned_steps(scene.solver));
+    originals.push_back(load_scene(file, command.overrides));
+    longest = std::max(longest, planned_steps(originals.back().solver));
   }
   if (command.windows > longest)
     throw InputError("precompute: --windows " + std::to_string(command.windows) + " exceeds the " +
@@ -64,8 +66,7 @@ void run_precompute_command(const PrecomputeCommand& command, std::ostream& log)
       command.output.parent_path() / (command.output.stem().string() + "_runs");
   for (std::size_t i = 0; i < command.scenes.size(); ++i) {
     const std::filesystem::path& file = command.scenes[i];
-    // The scene as written, to read its own tolerance; then the recorded run's settings.
-    const Scene original = load_scene(file, command.overrides);
+    const Scene& original = originals[i];
     if (!original.hierarchy)
       throw InputError(file.string() + ": precompute needs a \"hierarchy\" key (levels)");
     const double run_tolerance =

@@ -286,14 +286,16 @@ class AdaptiveSimulation final : public SimulationRun {
   double rebuild(long first_step);
   /// *m_simulation; throws std::logic_error when a failed cut change left none.
   const Simulation& live() const;
-  bool adapt(int pass, bool refine, bool coarsen);
+  /// One decision and its cut change; a positive `calibration_target` refines against it instead
+  /// of the tolerance (a calibration pass).
+  bool adapt(int pass, bool refine, bool coarsen, double calibration_target = 0.0);
   /// Changes the cut by `changes` and moves the mesh-level state (x, v) of the current cut, with
   /// its kinetic energy, momentum and per-tet plastic state, onto it; the new Simulation starts at
   /// `first_step`. The current Simulation is released before the new one is built, so the state
   /// is taken by value.
   void change_cut(const CutChanges& changes, int pass, long first_step, VectorXd x, VectorXd v,
                   double old_kinetic_energy, const Vector3d& old_momentum, PlasticState plastic);
-  CutChanges decide(bool refine, bool coarsen);
+  CutChanges decide(bool refine, bool coarsen, double calibration_target = 0.0);
   void advance_with_redo();
   void initial_adaptation();
   /// Mode precomputed: changes the cut to window `w` of the schedule (before the first step:
@@ -326,8 +328,6 @@ class AdaptiveSimulation final : public SimulationRun {
   /// measured the estimate makes one as well.
   VectorXd m_calibrated_shares;
   bool m_estimate_measured = false;  ///< whether a pass has measured the estimate (static runs)
-  /// While positive, the target a decision refines against instead of the tolerance.
-  double m_calibration_target = 0.0;
   static constexpr double kCalibrationGrowth = 1.25;
   static constexpr double kCalibrationFraction = 0.5;
   /// Estimates below this fraction of the tolerance (scaled) are not measured again.
