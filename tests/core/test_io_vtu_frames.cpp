@@ -10,6 +10,7 @@
 
 #include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
+#include "strata/core/common/parallel.hpp"
 #include "strata/core/io/pvd.hpp"
 #include "strata/core/io/vtu.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -84,6 +85,27 @@ TEST(IoVtuFrames, BothEncodingsReadBackTheIdenticalArrays) {
   }
   EXPECT_THAT(read_text(dir / "binary.vtu"), ::testing::HasSubstr("vtkZLibDataCompressor"));
   EXPECT_LT(fs::file_size(dir / "binary.vtu"), fs::file_size(dir / "ascii.vtu") / 2);
+}
+
+TEST(IoVtuFrames, ArraysOfManyCompressedBlocksReadBackAndDoNotDependOnTheThreads) {
+  // 12,000 tets: the stress array is 576,000 bytes, nine zlib blocks of 64 KiB, compressed in
+  // parallel and appended in order.
+  ScratchDir dir("io_frame_blocks");
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {10, 10, 20});
+  const Index nt = mesh.tets.rows();
+  ASSERT_GT(6 * nt * static_cast<Index>(sizeof(double)), 8 * 65536);
+  VtuFields fields;
+  const Eigen::MatrixXd stress = 1e6 * Eigen::MatrixXd::Random(nt, 6);
+  fields.add_cell_data("stress", stress);
+  write_vtu(dir / "threads.vtu", mesh.vertices, mesh.tets, fields, VtkEncoding::binary);
+  {
+    const ThreadLimit serial(1);
+    write_vtu(dir / "serial.vtu", mesh.vertices, mesh.tets, fields, VtkEncoding::binary);
+  }
+  EXPECT_EQ(read_text(dir / "threads.vtu"), read_text(dir / "serial.vtu"));
+  const VtkFrame frame = read_vtk_frame(dir / "threads.vtu");
+  EXPECT_TRUE((frame.cell_field("stress").array() == stress.array()).all());
+  EXPECT_TRUE((frame.points.array() == mesh.vertices.array()).all());
 }
 
 TEST(IoVtuFrames, FieldWithWrongRowCountIsInputErrorNamingIt) {

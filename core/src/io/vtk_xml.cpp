@@ -1,8 +1,10 @@
 #include "vtk_xml.hpp"
 
+#include <tbb/parallel_for.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <type_traits>
 
@@ -104,22 +106,35 @@ void DataArrayWriter::begin_file(std::ostream& out, const char* type) const {
 
 void DataArrayWriter::append_compressed(const std::uint8_t* data, std::size_t size) {
   const std::size_t num_blocks = (size + kBlockSize - 1) / kBlockSize;
+  // The blocks are compressed independently (in parallel, each into a buffer of its own) and
+  // appended in order: the bytes do not depend on the thread count.
+  std::vector<std::vector<std::uint8_t>> compressed(num_blocks);
+  std::atomic<bool> failed{false};
+  tbb::parallel_for(std::size_t(0), num_blocks, [&](std::size_t b) {
+    const std::size_t begin = b * kBlockSize;
+    const std::size_t length = std::min(kBlockSize, size - begin);
+    std::vector<std::uint8_t>& block = compressed[b];
+    uLongf compressed_size = compressBound(static_cast<uLong>(length));
+    block.resize(compressed_size);
+    if (compress2(block.data(), &compressed_size, data + begin, static_cast<uLong>(length),
+                  Z_BEST_SPEED) != Z_OK)
+      failed = true;
+    block.resize(compressed_size);
+  });
+  if (failed) throw std::runtime_error("zlib could not compress a VTK data block");
+  std::size_t total = 8 * (3 + num_blocks);
+  for (const std::vector<std::uint8_t>& block : compressed)
+    total += block.size();
   const std::size_t header_at = m_appended.size();
-  m_appended.resize(header_at + 8 * (3 + num_blocks));
+  m_appended.resize(header_at + total);
   put_u64(m_appended, header_at, num_blocks);
   put_u64(m_appended, header_at + 8, kBlockSize);
   put_u64(m_appended, header_at + 16, size % kBlockSize);  // 0: the last block is full
+  std::size_t at = header_at + 8 * (3 + num_blocks);
   for (std::size_t b = 0; b < num_blocks; ++b) {
-    const std::size_t begin = b * kBlockSize;
-    const std::size_t length = std::min(kBlockSize, size - begin);
-    uLongf compressed = compressBound(static_cast<uLong>(length));
-    const std::size_t at = m_appended.size();
-    m_appended.resize(at + compressed);
-    if (compress2(m_appended.data() + at, &compressed, data + begin, static_cast<uLong>(length),
-                  Z_BEST_SPEED) != Z_OK)
-      throw std::runtime_error("zlib could not compress a VTK data block");
-    m_appended.resize(at + compressed);
-    put_u64(m_appended, header_at + 8 * (3 + b), compressed);
+    put_u64(m_appended, header_at + 8 * (3 + b), compressed[b].size());
+    std::memcpy(m_appended.data() + at, compressed[b].data(), compressed[b].size());
+    at += compressed[b].size();
   }
 }
 
