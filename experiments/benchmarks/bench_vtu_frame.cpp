@@ -1,0 +1,58 @@
+// Writing one binary (zlib-compressed) .vtu frame with the fields the CLI writes: displacement
+// and velocity per vertex, Green strain, Cauchy stress, von Mises stress and level per tet.
+// Throughput in tets/s and the raw array bytes per second (bytes_per_second) for each mesh size
+// and thread count; the fields are computed once, outside the timed loop. Names:
+// vtu_frame/tets:<#T>/threads:<n>.
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include <strata/core/common/parallel.hpp>
+#include <strata/core/io/vtu.hpp>
+
+#include "bench_fixture.hpp"
+
+namespace strata::bench {
+namespace {
+
+void vtu_frame_benchmark(benchmark::State& state, MeshSize size, int threads) {
+  const ThreadLimit limit(threads);
+  const ModelCase& c = model_case(size, MaterialModel::neohookean);
+  const MatrixX3d positions = unflatten(c.deformed);
+  const TetFields tet_fields = c.model->tet_fields(c.deformed);
+  VtuFields fields;
+  fields.add_point_data("displacement", Eigen::MatrixXd(positions - c.mesh.vertices));
+  fields.add_point_data("velocity", Eigen::MatrixXd(positions - c.mesh.vertices));
+  fields.add_cell_data("green_strain", Eigen::MatrixXd(tet_fields.green_strain));
+  fields.add_cell_data("stress", Eigen::MatrixXd(tet_fields.cauchy_stress));
+  fields.add_cell_data("von_mises", Eigen::MatrixXd(tet_fields.von_mises));
+  fields.add_cell_data("level", Eigen::MatrixXi(Eigen::MatrixXi::Zero(c.mesh.tets.rows(), 1)));
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("strata_bench_frame_" + std::to_string(getpid()) + ".vtu");
+  for (auto _ : state)
+    write_vtu(path, positions, c.mesh.tets, fields, VtkEncoding::binary);
+  std::filesystem::remove(path);
+  const Index nv = c.mesh.vertices.rows(), nt = c.mesh.tets.rows();
+  // Float64: 3 + 3 + 3 (points) per vertex, 6 + 6 + 1 per tet; Int32 level, Int64 connectivity
+  // (4) and offsets (1), UInt8 type per tet.
+  const double raw_bytes = 8.0 * (9 * nv + 13 * nt) + 4.0 * nt + 8.0 * 5 * nt + 1.0 * nt;
+  state.SetItemsProcessed(state.iterations() * nt);
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * raw_bytes));
+  state.counters["tets"] = double(nt);
+  state.counters["threads"] = threads;
+}
+
+const bool registered = [] {
+  for (const MeshSize& size : mesh_sizes())
+    for (int threads : thread_counts())
+      benchmark::RegisterBenchmark(benchmark_name("vtu_frame", size, threads).c_str(),
+                                   vtu_frame_benchmark, size, threads)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  return true;
+}();
+
+}  // namespace
+}  // namespace strata::bench
