@@ -194,6 +194,7 @@ AdaptiveSimulation::AdaptiveSimulation(
   // (vetoed before the controller spends its element budget).
   m_controller->set_coarsening_veto([this](NodeId parent) {
     return !m_in_contact.contains(parent) &&
+           !(m_hold_load_floor && m_load_floor.contains(node_path(parent))) &&
            dirichlet_exact_on(*m_tree, parent, m_dirichlet, m_tolerance);
   });
   // The merges of a decision: none where it only refines or while a load with an amplitude is
@@ -365,6 +366,16 @@ void AdaptiveSimulation::initial_adaptation() {
     }
   }
   if (changed) rebuild(0);
+  // The cut just chosen is the floor of later merges while a load with an amplitude still grows.
+  const bool timed = !m_timed_point_loads.empty() ||
+                     std::any_of(m_dirichlet.begin(), m_dirichlet.end(), [](const auto& group) {
+                       return group.kind != DirichletKind::fixed && !group.amplitude.empty();
+                     });
+  if (timed && !m_at_full_resolution)
+    for (const NodeId n : m_cut->nodes())
+      for (NodeId p = m_tree->parent(n); p != kNoNode && m_load_floor.insert(node_path(p)).second;
+           p = m_tree->parent(p)) {
+      }
   m_report.initial_adaptation_seconds = seconds_since(start);
   m_bookkeeping_seconds += m_report.initial_adaptation_seconds;
 }
@@ -637,6 +648,33 @@ bool AdaptiveSimulation::load_grows_before_next_decision() const {
   return false;
 }
 
+bool AdaptiveSimulation::load_grows_later() const {
+  const double t = time();
+  const auto grows = [&](const Amplitude& amplitude) {
+    const double last = amplitude.points.back()[0];  // constant from there on
+    return last > t &&
+           amplitude.peak(t, last) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak();
+  };
+  for (const auto& [amplitude, point_loads] : m_timed_point_loads)
+    if (grows(amplitude)) return true;
+  for (const DirichletSpec& group : m_dirichlet)
+    if (group.kind != DirichletKind::fixed && !group.amplitude.empty() && grows(group.amplitude))
+      return true;
+  return false;
+}
+
+std::pair<int, std::uint64_t> AdaptiveSimulation::node_path(NodeId n) const {
+  // 1 followed by the child slots from the root down, three bits each (levels <= 20).
+  std::array<int, TetTree::kMaxSupportedLevel> slots{};
+  int depth = 0;
+  for (; m_tree->parent(n) != kNoNode; n = m_tree->parent(n))
+    slots[depth++] = m_tree->node(n).child_slot;
+  std::uint64_t path = 1;
+  while (depth > 0)
+    path = (path << 3) | static_cast<std::uint64_t>(slots[--depth]);
+  return {m_tree->node(n).root, path};
+}
+
 CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibration_target) {
   const Simulation& sim = *m_simulation;
   const FlatTreeMesh& flat = m_constrained->flat;
@@ -664,6 +702,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   // cannot see a load that is still to come, and merges made where it will act would meet it on
   // a coarse cut.
   m_decision_merges = coarsen && !load_grows_before_next_decision();
+  m_hold_load_floor = m_decision_merges && !m_load_floor.empty() && load_grows_later();
   CutChanges changes = m_controller->decide(state, *m_cut);
   if (!refine || within_tolerance) {
     changes.refine.clear();

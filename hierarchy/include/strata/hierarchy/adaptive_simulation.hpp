@@ -48,6 +48,7 @@
 /// kept with the momentum's direction (a cut change never adds kinetic energy).
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_set>
 #include <vector>
@@ -398,6 +399,19 @@ class AdaptiveSimulation final : public SimulationRun {
   /// steps (dynamic) or max(1, min_steps_between_changes) load steps (static) exceeds its
   /// magnitude now.
   bool load_grows_before_next_decision() const;
+  /// Whether a load or a prescribed motion with an amplitude grows at any later time of the run:
+  /// its largest magnitude after now exceeds its magnitude now.
+  bool load_grows_later() const;
+  /// Dynamic runs: the cut the initial adaptation chose for the static response at the loads'
+  /// peaks, as the nodes it refined (each by its root and its path of child slots, which outlive
+  /// the node ids a merge frees). While a load with an amplitude still grows later, no merge
+  /// makes the cut coarser than it: a pulse that comes back, or a load that starts late, then
+  /// meets the cut its peak needs. On a cut coarser than that (the roots) the estimate of a
+  /// load's first steps sees too little of it to refine in time.
+  std::set<std::pair<int, std::uint64_t>> m_load_floor;
+  /// Whether the decision in progress keeps the cut at least as fine as m_load_floor.
+  bool m_hold_load_floor = false;
+  std::pair<int, std::uint64_t> node_path(NodeId n) const;
   std::vector<PointLoad> m_point_loads;  ///< of the loads without an amplitude
   /// Loads with an amplitude, each on the finest level.
   std::vector<std::pair<Amplitude, std::vector<PointLoad>>> m_timed_point_loads;
