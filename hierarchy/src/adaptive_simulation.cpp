@@ -151,6 +151,11 @@ AdaptiveSimulation::AdaptiveSimulation(
   // to at least the energy of that strain over the body.
   m_energy_floor = m_material.youngs_modulus * tet_rest_volumes(coarse).sum() *
                    m_settings.criteria.stress_floor * m_settings.criteria.stress_floor;
+  // and to at least the displacement of that strain across the body.
+  {
+    const auto [lo, hi] = bounding_box(coarse.vertices);
+    m_displacement_floor = m_settings.criteria.stress_floor * (hi - lo).norm();
+  }
   if (!m_obstacles.empty())
     m_contact_stiffness = m_material.youngs_modulus *
                           mean_edge_length(coarse.vertices, coarse.tets) /
@@ -331,6 +336,7 @@ void AdaptiveSimulation::initial_adaptation() {
                    loads,           solve->vertex_mass(), m_material,         0,
                    &m_load_traction};
     state.solution_energy_scale = m_energy_floor;
+    state.solution_displacement_scale = m_displacement_floor;
     state.tolerance_scale = m_estimate_scale;
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
@@ -686,6 +692,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   CutState state{*m_tree,           flat,       sim.positions(),  fields,          loads,
                  sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
   state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
+  state.solution_displacement_scale = std::max(m_displacement_scale, m_displacement_floor);
   state.tolerance_scale = m_estimate_scale;
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
@@ -898,10 +905,12 @@ RecoveryEstimate AdaptiveSimulation::estimate_error() {
                    fields,     m_mesh_external,     sim.vertex_mass(),
                    m_material, sim.step_count(),    &m_load_traction};
     state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
+    state.solution_displacement_scale = std::max(m_displacement_scale, m_displacement_floor);
     m_estimate = recovery_error_estimate(state);
     m_estimate_valid = true;
   }
   m_energy_scale = m_estimate.reference_energy_sq;
+  m_displacement_scale = m_estimate.reference_displacement;
   return m_estimate;
 }
 
@@ -987,6 +996,7 @@ void AdaptiveSimulation::record_sample() {
     sample.estimated_energy_error = estimate.relative_energy_error;
     sample.estimated_upper_error = estimate.upper_error;
     sample.estimated_load_work_error = estimate.load_work_error;
+    sample.estimated_local_error = estimate.local_error;
   }
   if (!m_history.empty()) {  // accepted steps (the initial sample is the cut before any step)
     m_report.max_estimated_error = std::max(m_report.max_estimated_error, sample.estimated_error);

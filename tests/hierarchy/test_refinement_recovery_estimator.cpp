@@ -52,6 +52,36 @@ TEST(RecoveryEstimator, ZeroOnTheFinestLevel) {
   EXPECT_GT(estimate.relative_energy_error, 0.0);  // against the exact solution it is not zero
 }
 
+TEST(RecoveryEstimator, TheLocalEstimateSeesAWeakLoadTheEnergyNormDilutes) {
+  // A body-wide uniform strain (no recovery error, but most of the energy and the largest
+  // displacement) plus a narrow bump of a tenth of that displacement: relative to the whole
+  // body's energy the bump's error is diluted by about √(its width / the body's), relative to
+  // the largest displacement it is not. The local term is zero for the uniform strain alone.
+  TetTree tree(slab(), 2);
+  const ActiveCut cut = ActiveCut::uniform(tree, 0);
+  const auto uniform = [](const Vector3d& X) -> Vector3d { return Vector3d(0.01 * X.x(), 0, 0); };
+  const auto narrow = test::bump(Vector3d(0.5, 0.5, 0.25), 0.15, 0.001);
+  const auto both = [&](const Vector3d& X) -> Vector3d { return uniform(X) + narrow(X); };
+  const RecoveryEstimate alone =
+      recovery_error_estimate(make_snapshot(cut, test_material(), uniform, {}).state());
+  EXPECT_LE(alone.local_error, 1e-12);
+  const test::CutSnapshot s = make_snapshot(cut, test_material(), both, {});
+  const RecoveryEstimate estimate = recovery_error_estimate(s.state());
+  EXPECT_GT(estimate.local_error, 3.0 * estimate.recovery_error);
+  EXPECT_EQ(estimate.relative_error, estimate.local_error);
+  // The largest local term is a tet the bump touches.
+  Index peak = 0;
+  estimate.element_local_error.maxCoeff(&peak);
+  EXPECT_LT((node_centroid(tree, s.cut.flat.tet_nodes[peak]) - Vector3d(0.5, 0.5, 0.25)).norm(),
+            0.15 + 1.0 / 3.0);
+  // Relative to a larger displacement of the run so far, proportionally smaller.
+  test::CutSnapshot scaled = make_snapshot(cut, test_material(), both, {});
+  CutState state = scaled.state();
+  state.solution_displacement_scale = 10.0 * estimate.reference_displacement;
+  EXPECT_NEAR(recovery_error_estimate(state).local_error, 0.1 * estimate.local_error,
+              1e-12 * estimate.local_error);
+}
+
 TEST(RecoveryEstimator, PeaksAtAKinkOfTheField) {
   TetTree tree(slab(), 2);
   const ActiveCut cut = ActiveCut::uniform(tree, 0);
@@ -59,8 +89,10 @@ TEST(RecoveryEstimator, PeaksAtAKinkOfTheField) {
   const RecoveryEstimate estimate = recovery_error_estimate(s.state());
   EXPECT_GT(estimate.upper_error, 0.05);
   EXPECT_GT(estimate.load_work_error, 0.0);
-  EXPECT_NEAR(estimate.relative_error, std::sqrt(estimate.upper_error * estimate.load_work_error),
+  EXPECT_NEAR(estimate.recovery_error, std::sqrt(estimate.upper_error * estimate.load_work_error),
               1e-15);
+  EXPECT_EQ(estimate.relative_error, std::max(estimate.recovery_error, estimate.local_error));
+  EXPECT_GT(estimate.local_error, 0.0);
   Index peak = 0;
   estimate.element_error_sq.maxCoeff(&peak);
   EXPECT_NEAR(node_centroid(tree, s.cut.flat.tet_nodes[peak]).x(), 0.4, 1.0 / 6.0 + 1e-12);
@@ -111,15 +143,23 @@ TEST(RecoveryIndicator, MarksTetsAboveTheirShareOfTheTolerance) {
   VectorXd eta;
   RecoveryIndicator(0.01).evaluate(s.state(), eta);
   ASSERT_EQ(eta.size(), estimate.element_error_sq.size());
-  // Σ η̂² = N (z/τ_z)² with τ_z = (τ² z² / c)^⅓, i.e. N (e/τ)^{4/3}: the tets' shares of the
-  // tolerance on the upper estimate add up to it.
+  // η_t = max(η̂_t, δ_t / (τ max|u|)). Σ η̂² = N (z/τ_z)² with τ_z = (τ² z² / c)^⅓, i.e.
+  // N (√(zc)/τ)^{4/3}: the tets' shares of the tolerance on the upper estimate add up to it.
   const double n = static_cast<double>(eta.size());
   const double z = estimate.upper_error;
   const double upper_tolerance = std::cbrt(0.01 * 0.01 * z * z / estimate.load_work_error);
-  EXPECT_NEAR(eta.squaredNorm() / n, std::pow(estimate.upper_error / upper_tolerance, 2),
-              1e-9 * eta.squaredNorm() / n);
-  EXPECT_NEAR(eta.squaredNorm() / n, std::pow(estimate.relative_error / 0.01, 4.0 / 3.0),
-              1e-9 * eta.squaredNorm() / n);
+  const double share = upper_tolerance * upper_tolerance * estimate.reference_energy_sq / n;
+  const VectorXd eta_upper = (estimate.element_error_sq / share).cwiseSqrt();
+  const VectorXd eta_local =
+      estimate.element_local_error / (0.01 * estimate.reference_displacement);
+  for (Index t = 0; t < eta.size(); ++t)
+    EXPECT_NEAR(eta[t], std::max(eta_upper[t], eta_local[t]), 1e-12 * eta[t]) << "tet " << t;
+  EXPECT_NEAR(eta_upper.squaredNorm() / n, std::pow(estimate.upper_error / upper_tolerance, 2),
+              1e-9 * eta_upper.squaredNorm() / n);
+  EXPECT_NEAR(eta_upper.squaredNorm() / n, std::pow(estimate.recovery_error / 0.01, 4.0 / 3.0),
+              1e-9 * eta_upper.squaredNorm() / n);
+  // The local term marks exactly the tets whose δ_t exceeds τ max|u| (and no fewer).
+  EXPECT_NEAR(eta_local.maxCoeff(), estimate.local_error / 0.01, 1e-12 * eta_local.maxCoeff());
   EXPECT_GT(eta.maxCoeff(), 1.0);
   EXPECT_THROW(RecoveryIndicator(0.0), InputError);
   EXPECT_THROW(RecoveryIndicator(1.0), InputError);
@@ -151,8 +191,8 @@ TEST(MergeBudget, PredictsTheEstimateOfTheMergedCut) {
     const ActiveCut coarse = ActiveCut::uniform(tree, 0);
     const double merged =
         recovery_error_estimate(make_snapshot(coarse, test_material(), fields[f], {}).state())
-            .relative_error;
-    ASSERT_GT(merged, estimate.relative_error) << "field " << f;
+            .recovery_error;
+    ASSERT_GT(merged, estimate.recovery_error) << "field " << f;
     // The prediction is on the safe side. For smooth fields, whose error energy rises by 4 per
     // level as the prediction assumes, it may exceed the merged cut's estimate by at most 2 (a
     // prediction twice too high would hold back merges that half the budget's room could take;
@@ -165,6 +205,35 @@ TEST(MergeBudget, PredictsTheEstimateOfTheMergedCut) {
   }
 }
 
+TEST(MergeBudget, KeepsNoMergeWhoseLocalTermWouldExceedTheBudget) {
+  // A uniform strain plus a narrow bump on a uniform level-1 cut: the energy-norm estimate is
+  // diluted, the local term is not. With a budget above the current local term, the merges away
+  // from the bump are kept and those at it are not, and the merged cut's local term stays within
+  // the budget (the prediction is on the safe side).
+  TetTree tree(slab(), 2);
+  const auto narrow = test::bump(Vector3d(0.5, 0.5, 0.25), 0.15, 0.001);
+  const auto field = [&](const Vector3d& X) -> Vector3d {
+    return Vector3d(0.01 * X.x(), 0, 0) + narrow(X);
+  };
+  ActiveCut cut = ActiveCut::uniform(tree, 1);
+  const test::CutSnapshot s = make_snapshot(cut, test_material(), field, {});
+  const RecoveryEstimate estimate = recovery_error_estimate(s.state());
+  ASSERT_GT(estimate.local_error, 2.0 * estimate.recovery_error);
+  const double budget = 1.5 * estimate.local_error;
+  const BudgetedMerges merges = merges_within_budget(s.state(), estimate, roots(tree), budget);
+  EXPECT_GT(merges.kept.size(), 0u);
+  EXPECT_LT(merges.kept.size(), static_cast<std::size_t>(tree.num_roots()));
+  for (const NodeId parent : merges.kept)
+    cut.coarsen(parent);
+  const RecoveryEstimate merged =
+      recovery_error_estimate(make_snapshot(cut, test_material(), field, {}).state());
+  EXPECT_LE(merged.local_error, budget);
+  // The roots at the bump stay refined.
+  for (const NodeId parent : merges.kept)
+    EXPECT_GT((node_centroid(tree, parent) - Vector3d(0.5, 0.5, 0.25)).norm(), 0.15)
+        << "root " << parent;
+}
+
 TEST(MergeBudget, KeepsTheMergesWhosePredictedEstimateFitsTheBudget) {
   TetTree tree(slab(), 2);
   const ActiveCut cut = ActiveCut::uniform(tree, 1);
@@ -173,20 +242,21 @@ TEST(MergeBudget, KeepsTheMergesWhosePredictedEstimateFitsTheBudget) {
   const std::vector<NodeId> parents = roots(tree);
   const BudgetedMerges all = merges_within_budget(s.state(), estimate, parents, 1.0);
   ASSERT_EQ(all.kept, parents);
-  ASSERT_GT(all.predicted_error, estimate.relative_error);
+  ASSERT_GT(all.predicted_error, estimate.recovery_error);
 
-  // Below the current estimate nothing merges.
+  // Below the current energy-norm estimate √(zc) nothing merges (the budget is on it; the local
+  // term keeps merges from where it is large through the children's η).
   const BudgetedMerges none =
-      merges_within_budget(s.state(), estimate, parents, 0.9 * estimate.relative_error);
+      merges_within_budget(s.state(), estimate, parents, 0.9 * estimate.recovery_error);
   EXPECT_TRUE(none.kept.empty());
-  EXPECT_EQ(none.predicted_error, estimate.relative_error);
+  EXPECT_EQ(none.predicted_error, estimate.recovery_error);
 
   // In between: a proper subset within the budget, growing with it. The roots away from the kink
   // (x = 0.4) merge first: their children carry one uniform strain.
   std::size_t previous = 0;
   for (const double fraction : {0.25, 0.5, 0.75}) {
     const double budget =
-        estimate.relative_error + fraction * (all.predicted_error - estimate.relative_error);
+        estimate.recovery_error + fraction * (all.predicted_error - estimate.recovery_error);
     const BudgetedMerges some = merges_within_budget(s.state(), estimate, parents, budget);
     EXPECT_LE(some.predicted_error, budget);
     EXPECT_GE(some.kept.size(), previous);
@@ -196,10 +266,15 @@ TEST(MergeBudget, KeepsTheMergesWhosePredictedEstimateFitsTheBudget) {
   }
   EXPECT_GT(previous, 0u);
   // The roots two cells or more from the kink, whose children and their neighbours carry one
-  // uniform strain, merge at no predicted cost: within the smallest budget above.
+  // uniform strain, merge at no predicted cost: within the smallest budget above, once it is
+  // above the local term too (nothing merges while ℓ exceeds the budget).
+  ASSERT_GT(estimate.local_error, 0.0);
   const BudgetedMerges smallest = merges_within_budget(
       s.state(), estimate, parents,
-      estimate.relative_error + 0.25 * (all.predicted_error - estimate.relative_error));
+      std::max(estimate.local_error,
+               estimate.recovery_error + 0.25 * (all.predicted_error - estimate.recovery_error)));
+  EXPECT_TRUE(
+      merges_within_budget(s.state(), estimate, parents, 0.99 * estimate.local_error).kept.empty());
   int far = 0;
   for (const NodeId root : parents)
     if (std::abs(node_centroid(tree, root).x() - 0.4) > 0.25) {
@@ -219,7 +294,7 @@ TEST(MergeBudget, KeepsTheMergesWhosePredictedEstimateFitsTheBudget) {
       merges_within_budget(p.state(), plastic_estimate, parents, 1.0);
   ASSERT_EQ(plastic_all.kept, parents);
   const double plastic_budget =
-      0.5 * (plastic_estimate.relative_error + plastic_all.predicted_error);
+      0.5 * (plastic_estimate.recovery_error + plastic_all.predicted_error);
   const BudgetedMerges plastic_some =
       merges_within_budget(p.state(), plastic_estimate, parents, plastic_budget);
   EXPECT_LE(plastic_some.predicted_error, plastic_budget);

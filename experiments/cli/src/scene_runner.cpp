@@ -183,7 +183,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
                             {"estimated_error", nlohmann::json::array()},
                             {"estimated_energy_error", nlohmann::json::array()},
                             {"estimated_upper_error", nlohmann::json::array()},
-                            {"estimated_load_work_error", nlohmann::json::array()}};
+                            {"estimated_load_work_error", nlohmann::json::array()},
+                            {"estimated_local_error", nlohmann::json::array()}};
   for (const CutSample& sample : adaptive.history()) {
     history["step"].push_back(sample.step);
     history["time"].push_back(sample.time);
@@ -194,6 +195,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
     history["estimated_energy_error"].push_back(sample.estimated_energy_error);
     history["estimated_upper_error"].push_back(sample.estimated_upper_error);
     history["estimated_load_work_error"].push_back(sample.estimated_load_work_error);
+    history["estimated_local_error"].push_back(sample.estimated_local_error);
   }
   block["history"] = history;
   Index refinements = 0, coarsenings = 0;

@@ -174,6 +174,8 @@ struct CutSample {
   /// relative error of the load's work c.
   double estimated_upper_error = 0.0;
   double estimated_load_work_error = 0.0;
+  /// The local estimate ℓ (refinement_recovery_estimator.hpp).
+  double estimated_local_error = 0.0;
 };
 
 /// How the run kept its tolerance.
@@ -429,6 +431,10 @@ class AdaptiveSimulation final : public SimulationRun {
   double m_energy_scale = 0.0;  ///< largest ‖u‖_E² of the accepted steps so far [J]
   /// E × volume × stress_floor²: the smallest ‖u‖_E² an estimate is relative to [J].
   double m_energy_floor = 0.0;
+  /// The largest vertex displacement of the accepted steps so far, and its floor (stress_floor
+  /// strain across the body's diagonal): what the local estimate is relative to [m].
+  double m_displacement_scale = 0.0;
+  double m_displacement_floor = 0.0;
   RecoveryEstimate m_estimate;  ///< of the current state while m_estimate_valid
   bool m_estimate_valid = false;
 };

@@ -47,6 +47,9 @@ struct CutState {
   /// over the run so far, so that the first small-strain steps of a run are not judged relative
   /// to their own tiny deformation. 0: the state's own.
   double solution_energy_scale = 0.0;
+  /// Optional: the largest vertex displacement [m] the local error estimate is relative to — the
+  /// largest over the run so far. 0: the state's own.
+  double solution_displacement_scale = 0.0;
   /// Optional: the recovery estimate of this very state (refinement_recovery_estimator.hpp),
   /// when the driver has computed it already; the recovery indicator then reuses it.
   const RecoveryEstimate* recovery_estimate = nullptr;
