@@ -656,8 +656,10 @@ bool AdaptiveSimulation::load_grows_before_next_decision() const {
 
 bool AdaptiveSimulation::load_grows_later() const {
   const double t = time();
+  const double end = is_static(m_solver) ? 1.0 : m_solver.duration;
   const auto grows = [&](const Amplitude& amplitude) {
-    const double last = amplitude.points.back()[0];  // constant from there on
+    // Constant after its last point; the run ends at `end`.
+    const double last = std::min(amplitude.points.back()[0], end);
     return last > t &&
            amplitude.peak(t, last) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak();
   };

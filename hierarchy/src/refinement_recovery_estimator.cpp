@@ -95,9 +95,10 @@ double frobenius(const Vector6d& e) {
 }
 
 /// The predicted local term δ of the parent (level `parent_level`) of eight sibling flat tets
-/// once merged [m]: its size (the edge of a regular tet of their total volume, twice theirs)
-/// times the largest strain error of a child plus the largest deviation of a child's strain from
-/// their mean, which the parent's one linear field averages away.
+/// once merged [m]: the parent's share times its size (the edge of a regular tet of their total
+/// volume, twice theirs) times the largest strain error of a child not on the finest level plus
+/// the largest deviation of a child's strain from their mean, which the parent's one linear field
+/// averages away.
 double merged_local_error(const CutState& state, const RecoveryEstimate& estimate,
                           const std::array<int, 8>& children, int depth, int parent_level) {
   const TetMesh& mesh = state.flat.mesh;
@@ -115,6 +116,9 @@ double merged_local_error(const CutState& state, const RecoveryEstimate& estimat
   }
   if (!(total > 0.0)) return 0.0;
   mean /= total;
+  // The children's strain errors as their own local terms count them: relative to the finest
+  // level, so nothing on it (the full-resolution run has the same), and the detail each child
+  // adds to the parent's error on top.
   const double child_share = local_share_removed(depth, parent_level + 1);
   double child_difference = 0.0, detail = 0.0;
   for (int k = 0; k < 8; ++k) {
@@ -192,8 +196,9 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
       estimate.element_error_sq[t] = error_sq * removed[level] * removed[level];
       estimate.element_raw_error_sq[t] = error_sq;
       load_work_terms[t] = error_sq * c_share[level];
-      estimate.element_local_error[t] =
-          local_share[level] * std::cbrt(kRegularTetEdgeCubed * volume[t]) * largest_difference;
+      estimate.element_local_error[t] = local_share[level] *
+                                        std::cbrt(kRegularTetEdgeCubed * std::abs(volume[t])) *
+                                        largest_difference;
       energy_terms[t] = volume[t] * twice_energy_density(own, lame);
     }
   });

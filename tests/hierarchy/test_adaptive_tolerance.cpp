@@ -384,7 +384,8 @@ TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
   solver.dt = 0.002;
   solver.duration = 0.03;
   const auto merges_at_step_10 = [&](const std::vector<std::array<double, 2>>& right_amplitude,
-                                     double tolerance = 0.01) {
+                                     double tolerance = 0.01, double duration = 0.03) {
+    solver.duration = duration;
     HierarchySettings hierarchy = defaults(2);
     hierarchy.tolerance = tolerance;
     const auto sim =
@@ -397,9 +398,11 @@ TEST(AdaptiveTolerance, NoMergesWhileALoadIsStillGrowing) {
     return coarsened;
   };
   EXPECT_EQ(merges_at_step_10({{0.0, 0.0}, {0.03, 0.0}, {0.07, 1.0}}), 0);
-  // Starting after them, it still grows later: the initial adaptation's cut is the floor of
-  // merges until then (at any tolerance).
-  EXPECT_EQ(merges_at_step_10({{0.0, 0.0}, {0.045, 0.0}, {0.07, 1.0}}, 0.05), 0);
+  // Starting after them, in a run that lasts until it grows, it still grows later: the initial
+  // adaptation's cut is the floor of merges until then (at any tolerance). In a run that ends
+  // before it starts (0.03 s) it never grows, and the same decision merges.
+  EXPECT_EQ(merges_at_step_10({{0.0, 0.0}, {0.045, 0.0}, {0.07, 1.0}}, 0.05, 0.08), 0);
+  EXPECT_GT(merges_at_step_10({{0.0, 0.0}, {0.045, 0.0}, {0.07, 1.0}}, 0.05, 0.03), 0);
   // Holding a plateau it grows no more, and the same decision merges (at τ = 5 %; at 1 % the
   // children under the patches stay marked by the local term of the estimate).
   EXPECT_GT(merges_at_step_10({{0.0, 0.0}, {0.01, 0.7}, {0.5, 0.7}, {0.6, 0.0}}, 0.05), 0);

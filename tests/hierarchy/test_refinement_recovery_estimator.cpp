@@ -244,8 +244,13 @@ TEST(MergeBudget, KeepsTheMergesWhosePredictedEstimateFitsTheBudget) {
   ASSERT_EQ(all.kept, parents);
   ASSERT_GT(all.predicted_error, estimate.recovery_error);
 
-  // Below the current energy-norm estimate √(zc) nothing merges (the budget is on it; the local
-  // term keeps merges from where it is large through the children's η).
+  // Below the current energy-norm estimate √(zc) nothing merges (the budget is on it), also with
+  // the local term taken out of the estimate.
+  RecoveryEstimate energy_only = estimate;
+  energy_only.local_error = 0.0;
+  energy_only.element_local_error.setZero();
+  EXPECT_TRUE(merges_within_budget(s.state(), energy_only, parents, 0.9 * estimate.recovery_error)
+                  .kept.empty());
   const BudgetedMerges none =
       merges_within_budget(s.state(), estimate, parents, 0.9 * estimate.recovery_error);
   EXPECT_TRUE(none.kept.empty());

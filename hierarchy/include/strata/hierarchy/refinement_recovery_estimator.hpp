@@ -34,12 +34,9 @@
 /// is the relative displacement error in the load's own direction, weighted by the load; the
 /// largest probe error is mostly larger (c was 0.1–1.1 times it on the project's adaptive cuts).
 /// The two bracket the error, c ≤ error ≤ z, on most measured cuts, up to 50 apart, and the
-/// estimate is their geometric mean,
-///
-///     e = √(z c)
-///
-/// (for plastic materials e = z: the identity behind c holds for elastic states only, and a
-/// plastic zone formed on a coarse cut stays in the run's history).
+/// energy-norm estimate is their geometric mean √(z c) (for plastic materials z: the identity
+/// behind c holds for elastic states only, and a plastic zone formed on a coarse cut stays in the
+/// run's history).
 ///
 /// Both are relative to the whole body's energy, which dilutes the error at a load much weaker
 /// than the body's main one (a small patch beside a large one, a patch on a body sagging under
@@ -48,28 +45,30 @@
 /// |E* − E_t| across a tet of size h_t (the edge of a regular tet of its volume) is a
 /// displacement error of about h_t |E* − E_t|, and
 ///
-///     ℓ = max_t (1 − 2^−(L−ℓ_t)) h_t max_i |E*_i − E_t| / max |u|,
+///     e_loc = max_t δ_t / max |u|,   δ_t = (1 − 2^−(L−ℓ_t)) h_t max_i |E*_i − E_t|,
 ///
 /// over the tet's vertices i, |·| the Frobenius norm, relative to the largest displacement (of
 /// the run so far, CutState::solution_displacement_scale). It sees no error spread over the body
-/// (bending of coarse tets, which e sees), and the estimate of the run is the larger of the two,
-/// e := max(√(z c), ℓ). Its effectivity (e / true
-/// error) was 1.2–2.4 on the adaptive runs of the project's local-load and cantilever scenes,
-/// 2.8 on the column and 3.6 on the armadillo (probes away from where the error is) and 0.57–2.5
-/// on most uniform cuts (README, "Error control"). e is the estimated error of the run in the
-/// measure hierarchy.tolerance bounds. It is zero for affine fields and uniform strain, grows
-/// with strain jumps between neighbours (bending on coarse tets, concentrated loads), and is zero
-/// on the finest level.
+/// (bending of coarse tets, which √(z c) sees), and the estimate of the run is the larger of the
+/// two,
+///
+///     e = max(√(z c), e_loc).
+///
+/// e is the estimated error of the run in the measure hierarchy.tolerance bounds. It is zero for
+/// affine fields and uniform strain, grows with strain jumps between neighbours (bending on
+/// coarse tets, concentrated loads), and is zero on the finest level. The effectivities of √(z c)
+/// and of e on the project's scenes are in the README ("Error control", "Multiresolution runs:
+/// measured").
 ///
 /// As a refinement indicator the estimate is normalised by an equidistributed share of a
 /// tolerance τ_z on z: η̂_t = √(N η_t,full² / ((τ_z/C)² ‖u‖_E²)), with N the number of active tets,
 /// so η̂ > 1 marks the tets whose error exceeds their share (refine_threshold 1). The heuristic
-/// τ_z = (τ² z² / c)^⅓ = z (τ/e)^⅔ is z when e = τ (it would mean e ≤ τ exactly if c fell as z²
-/// under refinement); then Σ_t η̂_t² = N (e/τ)^{4/3} (elastic, c > 0; plastic: τ_z = τ and
-/// N (e/τ)²; c = 0: τ_z = ∞ and η̂ = 0). The coarsening test of the children's η̂ uses the same
-/// normalisation; merge_indicator uses min(τ, τ_z), as a merge raises c, which τ_z does not see.
-/// A tet whose local term exceeds the tolerance, δ_t > τ max|u|, is marked as well:
-/// η_t = max(η̂_t, δ_t / (τ max|u|)).
+/// τ_z = (τ² z² / c)^⅓ = z (τ/√(z c))^⅔ is z when √(z c) = τ (it would mean √(z c) ≤ τ exactly
+/// if c fell as z² under refinement); then Σ_t η̂_t² = N (√(z c)/τ)^{4/3} (elastic, c > 0;
+/// plastic: τ_z = τ and N (z/τ)²; c = 0: τ_z = ∞ and η̂ = 0). The coarsening test of the
+/// children's η̂ uses the same normalisation; merge_indicator uses min(τ, τ_z), as a merge raises
+/// c, which τ_z does not see. A tet whose local term exceeds the tolerance, δ_t > τ max|u|, is
+/// marked as well: η_t = max(η̂_t, δ_t / (τ max|u|)).
 #include <vector>
 
 #include "strata/hierarchy/refinement_indicator.hpp"
@@ -85,7 +84,8 @@ struct RecoveryEstimate {
   double solution_energy_sq = 0.0;  ///< ‖u‖_E² of this state [J]
   /// max(‖u‖_E², state.solution_energy_scale): what the relative errors are relative to [J].
   double reference_energy_sq = 0.0;
-  /// The estimated relative displacement error against full resolution, e = √(z c) above.
+  /// The estimated relative displacement error against full resolution, e = max(√(z c), e_loc)
+  /// above.
   double relative_error = 0.0;
   /// The upper estimate z above.
   double upper_error = 0.0;
@@ -100,11 +100,12 @@ struct RecoveryEstimate {
   /// larger of with local_error; the refinement marking's share τ_z follows from it.
   double recovery_error = 0.0;
   /// δ_t = (1 − 2^−(L−ℓ_t)) h_t max_i |E*_i − E_t| per flat tet [m]: the displacement a strain
-  /// error across the tet's size amounts to, the part refinement to the finest level removes.
+  /// error across the tet's size amounts to, the part refinement to the finest level removes
+  /// (zero on the finest level, whose strain error the full-resolution run shares).
   VectorXd element_local_error;
   /// max(largest vertex displacement of this state, state.solution_displacement_scale) [m].
   double reference_displacement = 0.0;
-  /// The local estimate ℓ = max_t δ_t / reference_displacement.
+  /// The local estimate e_loc = max_t δ_t / reference_displacement.
   double local_error = 0.0;
 };
 
@@ -118,17 +119,17 @@ struct BudgetedMerges {
 };
 
 /// The merges of `parents` (each a parent whose eight children are active tets of state.flat)
-/// that keep the predicted energy-norm estimate √(z c) within `budget`, and the local term ℓ
+/// that keep the predicted energy-norm estimate √(z c) within `budget`, and the local term e_loc
 /// too. A merge replaces the children's terms by the parent's, whose squared error is predicted
 /// as the larger of 4 Σ_k η_k² (the error energy of linear elements rises by 4 per level
 /// coarser) and Σ_k η_k² plus the energy the merge removes (RecoveryIndicator::merge_indicator);
 /// z and c follow with the parent's level. The merges are visited in order of the estimate each
 /// alone would leave, and each is kept if the predicted √(z c) with it and the merges kept
 /// before stays within the budget. Every rise is ≥ 0, so a state whose estimate already exceeds
-/// the budget keeps none. A state without deformation keeps every merge. For ℓ: while it
+/// the budget keeps none. A state without deformation keeps every merge. For e_loc: while it
 /// exceeds the budget nothing merges, and a merge whose parent's predicted δ (its size times its
-/// children's largest strain error plus the largest deviation of a child's strain from their
-/// mean) exceeds half the budget times max |u| is not made.
+/// children's share-weighted strain error, zero on the finest level, plus the largest deviation
+/// of a child's strain from their mean) exceeds half the budget times max |u| is not made.
 BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimate& estimate,
                                     const std::vector<NodeId>& parents, double budget);
 
