@@ -373,10 +373,7 @@ void AdaptiveSimulation::initial_adaptation() {
   }
   if (changed) rebuild(0);
   // The cut just chosen is the floor of later merges while a load with an amplitude still grows.
-  const bool timed = !m_timed_point_loads.empty() ||
-                     std::any_of(m_dirichlet.begin(), m_dirichlet.end(), [](const auto& group) {
-                       return group.kind != DirichletKind::fixed && !group.amplitude.empty();
-                     });
+  const bool timed = any_timed_amplitude([](const Amplitude&) { return true; });
   if (timed && !m_at_full_resolution)
     for (const NodeId n : m_cut->nodes())
       for (NodeId p = m_tree->parent(n); p != kNoNode && m_load_floor.insert(node_path(p)).second;
@@ -633,42 +630,26 @@ bool AdaptiveSimulation::load_grows_before_next_decision() const {
   // runs: the next load step, whose solve starts on the merged cut), and a merged node may not
   // be refined again for min_steps_between_changes steps: the horizon is the longer of the two
   // (t is the load factor in static runs).
-  const double t = time();
   const long steps = std::max<long>(is_static(m_solver) ? 1 : m_settings.adapt_every,
                                     m_settings.criteria.min_steps_between_changes);
   const double horizon =
       static_cast<double>(steps) *
       (is_static(m_solver) ? 1.0 / static_cast<double>(m_solver.load_steps) : m_solver.dt);
-  // A plateau's interpolated values differ from the table's in the last bits: growth is a rise
-  // beyond round-off of the amplitude's peak.
-  const auto grows = [&](const Amplitude& amplitude) {
-    return amplitude.peak(t, t + horizon) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak();
-  };
-  for (const auto& [amplitude, point_loads] : m_timed_point_loads)
-    if (grows(amplitude)) return true;
-  // Prescribed motions on an amplitude table likewise (fixed groups do not move; groups on the
-  // run's default ramp grow in proportion from the start).
-  for (const DirichletSpec& group : m_dirichlet)
-    if (group.kind != DirichletKind::fixed && !group.amplitude.empty() && grows(group.amplitude))
-      return true;
-  return false;
+  return load_grows_until(time() + horizon);
 }
 
 bool AdaptiveSimulation::load_grows_later() const {
+  return load_grows_until(std::max(time(), is_static(m_solver) ? 1.0 : m_solver.duration));
+}
+
+bool AdaptiveSimulation::load_grows_until(double until) const {
   const double t = time();
-  const double end = is_static(m_solver) ? 1.0 : m_solver.duration;
+  // A plateau's interpolated values differ from the table's in the last bits: growth is a rise
+  // beyond round-off of the amplitude's peak (a table is constant after its last point).
   const auto grows = [&](const Amplitude& amplitude) {
-    // Constant after its last point; the run ends at `end`.
-    const double last = std::min(amplitude.points.back()[0], end);
-    return last > t &&
-           amplitude.peak(t, last) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak();
+    return amplitude.peak(t, until) > std::abs(amplitude.value(t)) + 1e-9 * amplitude.peak();
   };
-  for (const auto& [amplitude, point_loads] : m_timed_point_loads)
-    if (grows(amplitude)) return true;
-  for (const DirichletSpec& group : m_dirichlet)
-    if (group.kind != DirichletKind::fixed && !group.amplitude.empty() && grows(group.amplitude))
-      return true;
-  return false;
+  return any_timed_amplitude(grows);
 }
 
 std::pair<int, std::uint64_t> AdaptiveSimulation::node_path(NodeId n) const {

@@ -59,27 +59,40 @@ double upper_tolerance(const RecoveryEstimate& estimate, double tolerance) {
                    estimate.load_work_error);
 }
 
-/// Σ_k 2 V_k ψ(E_k − Ē) over the eight children (flat tets), Ē their volume-weighted mean Green
-/// strain: the strain energy of the detail a merge into the parent averages away [J].
-double merge_loss(const CutState& state, const std::array<int, 8>& children) {
+/// Eight sibling flat tets: their rest volumes, total volume and volume-weighted mean Green
+/// strain Ē (the strain of the parent's one linear field).
+struct Siblings {
+  std::array<double, 8> volume{};
+  double total = 0.0;
+  Vector6d mean = Vector6d::Zero();
+};
+
+Siblings siblings(const CutState& state, const std::array<int, 8>& children) {
   const TetMesh& mesh = state.flat.mesh;
   const auto& strain = state.fields.green_strain;
-  std::array<double, 8> volume{};
-  Vector6d mean = Vector6d::Zero();
-  double total = 0.0;
+  Siblings result;
   for (int k = 0; k < 8; ++k) {
     const auto corner = [&](int i) {
       return Vector3d(mesh.vertices.row(mesh.tets(children[k], i)).transpose());
     };
-    volume[k] = std::abs(tet_signed_volume(corner(0), corner(1), corner(2), corner(3)));
-    mean += volume[k] * strain.row(children[k]).transpose();
-    total += volume[k];
+    result.volume[k] = std::abs(tet_signed_volume(corner(0), corner(1), corner(2), corner(3)));
+    result.mean += result.volume[k] * strain.row(children[k]).transpose();
+    result.total += result.volume[k];
   }
-  mean /= total;
+  if (result.total > 0.0) result.mean /= result.total;
+  return result;
+}
+
+/// Σ_k 2 V_k ψ(E_k − Ē) over the eight children (flat tets): the strain energy of the detail a
+/// merge into the parent averages away [J].
+double merge_loss(const CutState& state, const std::array<int, 8>& children) {
+  const Siblings sibling = siblings(state, children);
+  const auto& strain = state.fields.green_strain;
   const LameParameters lame = state.material.lame();
   double loss = 0.0;
   for (int k = 0; k < 8; ++k)
-    loss += volume[k] * twice_energy_density(strain.row(children[k]).transpose() - mean, lame);
+    loss += sibling.volume[k] *
+            twice_energy_density(strain.row(children[k]).transpose() - sibling.mean, lame);
   return loss;
 }
 
@@ -101,35 +114,23 @@ double frobenius(const Vector6d& e) {
 /// averages away.
 double merged_local_error(const CutState& state, const RecoveryEstimate& estimate,
                           const std::array<int, 8>& children, int depth, int parent_level) {
-  const TetMesh& mesh = state.flat.mesh;
+  const Siblings sibling = siblings(state, children);
+  if (!(sibling.total > 0.0)) return 0.0;
   const auto& strain = state.fields.green_strain;
-  std::array<double, 8> volume{};
-  Vector6d mean = Vector6d::Zero();
-  double total = 0.0;
-  for (int k = 0; k < 8; ++k) {
-    const auto corner = [&](int i) {
-      return Vector3d(mesh.vertices.row(mesh.tets(children[k], i)).transpose());
-    };
-    volume[k] = std::abs(tet_signed_volume(corner(0), corner(1), corner(2), corner(3)));
-    mean += volume[k] * strain.row(children[k]).transpose();
-    total += volume[k];
-  }
-  if (!(total > 0.0)) return 0.0;
-  mean /= total;
   // The children's strain errors as their own local terms count them: relative to the finest
   // level, so nothing on it (the full-resolution run has the same), and the detail each child
   // adds to the parent's error on top.
   const double child_share = local_share_removed(depth, parent_level + 1);
   double child_difference = 0.0, detail = 0.0;
   for (int k = 0; k < 8; ++k) {
-    const double h = std::cbrt(kRegularTetEdgeCubed * volume[k]);
+    const double h = std::cbrt(kRegularTetEdgeCubed * sibling.volume[k]);
     if (child_share > 0.0 && h > 0.0)
       child_difference =
           std::max(child_difference, estimate.element_local_error[children[k]] / (child_share * h));
-    detail = std::max(detail, frobenius(strain.row(children[k]).transpose() - mean));
+    detail = std::max(detail, frobenius(strain.row(children[k]).transpose() - sibling.mean));
   }
-  return local_share_removed(depth, parent_level) * std::cbrt(kRegularTetEdgeCubed * total) *
-         (child_difference + detail);
+  return local_share_removed(depth, parent_level) *
+         std::cbrt(kRegularTetEdgeCubed * sibling.total) * (child_difference + detail);
 }
 
 }  // namespace

@@ -404,6 +404,20 @@ class AdaptiveSimulation final : public SimulationRun {
   /// Whether a load or a prescribed motion with an amplitude grows at any later time of the run:
   /// its largest magnitude after now exceeds its magnitude now.
   bool load_grows_later() const;
+  /// Whether a load or a prescribed motion with an amplitude rises beyond its magnitude now
+  /// before `until` (time, or load factor in static runs).
+  bool load_grows_until(double until) const;
+  /// Whether `test` holds for the amplitude of a load, or of a prescribed motion (fixed groups
+  /// do not move; groups on the run's default ramp grow in proportion from the start).
+  template <typename Test>
+  bool any_timed_amplitude(Test&& test) const {
+    for (const auto& [amplitude, point_loads] : m_timed_point_loads)
+      if (test(amplitude)) return true;
+    for (const DirichletSpec& group : m_dirichlet)
+      if (group.kind != DirichletKind::fixed && !group.amplitude.empty() && test(group.amplitude))
+        return true;
+    return false;
+  }
   /// Dynamic runs: the cut the initial adaptation chose for the static response at the loads'
   /// peaks, as the nodes it refined (each by its root and its path of child slots, which outlive
   /// the node ids a merge frees). While a load with an amplitude still grows later, no merge
