@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 
 #include "level_set_impl.hpp"
@@ -25,9 +26,7 @@ void ensure_openvdb_initialized() {
 
 LevelSet wrap_level_set(openvdb::FloatGrid::Ptr grid) {
   grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  auto impl = std::make_unique<LevelSet::Impl>();
-  impl->grid = std::move(grid);
-  return LevelSet(std::move(impl));
+  return LevelSet(std::make_unique<LevelSet::Impl>(std::move(grid)));
 }
 
 void check_level_set_options(const LevelSetOptions& options, const std::string& what) {
@@ -76,17 +75,25 @@ openvdb::FloatGrid::Ptr empty_grid() {
 
 }  // namespace
 
-LevelSet::LevelSet() : m_impl(std::make_unique<Impl>()) {
-  m_impl->grid = empty_grid();
+LevelSet::Impl::Impl(openvdb::FloatGrid::Ptr level_set) : grid(std::move(level_set)) {
+  const openvdb::FloatTree& tree = grid->tree();
+  tree.evalLeafBoundingBox(extent);
+  const float background = tree.background();
+  openvdb::FloatTree::ValueAllCIter tile = tree.cbeginValueAll();
+  tile.setMaxDepth(openvdb::FloatTree::ValueAllCIter::LEAF_DEPTH - 1);  // tiles, not voxels
+  for (; tile; ++tile)
+    if (*tile != background) extent.expand(tile.getBoundingBox());
 }
+
+LevelSet::LevelSet() : m_impl(std::make_unique<Impl>(empty_grid())) {}
 LevelSet::LevelSet(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
 LevelSet::~LevelSet() = default;
-LevelSet::LevelSet(const LevelSet& other) : m_impl(std::make_unique<Impl>()) {
+LevelSet::LevelSet(const LevelSet& other) : m_impl(std::make_unique<Impl>(*other.m_impl)) {
   m_impl->grid = other.m_impl->grid->deepCopy();
 }
 LevelSet& LevelSet::operator=(const LevelSet& other) {
   if (this == &other) return *this;
-  if (!m_impl) m_impl = std::make_unique<Impl>();
+  m_impl = std::make_unique<Impl>(*other.m_impl);
   m_impl->grid = other.m_impl->grid->deepCopy();
   return *this;
 }
@@ -149,8 +156,22 @@ void catmull_rom_weights(double t, double w[4], double dw[4]) {
 
 double LevelSet::smooth_signed_distance_and_gradient(const Vector3d& p, Vector3d& gradient) const {
   const openvdb::FloatGrid& grid = *m_impl->grid;
-  UnsafeAccessor accessor(grid.tree());
   const openvdb::Vec3d x = grid.transform().worldToIndex(openvdb::Vec3d(p(0), p(1), p(2)));
+  // The stencil reads the voxels floor(x) − 1 … floor(x) + 2 on each axis: where they all lie
+  // outside the extent, they all hold the background, and so does the interpolant.
+  const openvdb::CoordBBox& extent = m_impl->extent;
+  for (int a = 0; a < 3; ++a) {
+    const double below = std::floor(x[a]);
+    if (!std::isfinite(below)) {
+      gradient.setConstant(std::numeric_limits<double>::quiet_NaN());
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    if (extent.empty() || !(below + 2.0 >= extent.min()[a] && below - 1.0 <= extent.max()[a])) {
+      gradient.setZero();
+      return grid.background();
+    }
+  }
+  UnsafeAccessor accessor(grid.tree());
   const openvdb::Coord base(static_cast<int>(std::floor(x[0])), static_cast<int>(std::floor(x[1])),
                             static_cast<int>(std::floor(x[2])));
   double w[3][4], dw[3][4];

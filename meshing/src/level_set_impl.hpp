@@ -9,7 +9,11 @@
 namespace strata {
 
 struct LevelSet::Impl {
+  explicit Impl(openvdb::FloatGrid::Ptr level_set);
   openvdb::FloatGrid::Ptr grid;  ///< never null; GRID_LEVEL_SET with a uniform linear transform
+  /// Index box outside which every voxel holds the background: the leaves' box and that of every
+  /// tile whose value differs from the background (empty for an empty grid).
+  openvdb::CoordBBox extent;
 };
 
 namespace detail {

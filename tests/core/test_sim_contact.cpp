@@ -111,6 +111,75 @@ Material rubber() {
   return material;
 }
 
+/// φ + d̂ of `obstacle` at x.
+double room(const Obstacle& obstacle, const Vector3d& x, double distance) {
+  Vector3d gradient;
+  return obstacle.distance(x, gradient) + distance;
+}
+
+TEST(ContactStepFilter, APointInContactSlidesAndOneMovingInStopsAtATenthOfItsRoom) {
+  // The plane z = 0, d̂ = 0.01; a point 0.99 d̂ deep (room r₀ = 1e-4 m).
+  const double distance = 0.01, r0 = 1e-4;
+  const std::vector<Obstacle> obstacles = {
+      plane_obstacle("plane", Vector3d::Zero(), Vector3d::UnitZ())};
+  const ContactTerm term(obstacles, std::vector<int>{0}, {distance, 50.0, 1e-4});
+  const Vector3d x(0.3, -0.2, r0 - distance);
+  // Sliding along the plane (or leaving it) keeps the room: the whole step. The Lipschitz bound
+  // alone, 0.9 r₀ / ‖Δx‖, would allow 1.8e-3 of it.
+  EXPECT_EQ(term.max_step(x, Vector3d(0.05, 0.0, 0.0)), 1.0);
+  EXPECT_EQ(term.max_step(x, Vector3d(-0.03, 0.04, 0.0)), 1.0);
+  EXPECT_EQ(term.max_step(x, Vector3d(0.0, 0.0, 0.05)), 1.0);
+  // Moving in, straight or while sliding, r(α) = r₀ − α Δz falls to r₀ / 10 at α = 0.9 r₀ / |Δz|.
+  EXPECT_NEAR(term.max_step(x, Vector3d(0.0, 0.0, -1e-3)), 0.09, 1e-12);
+  EXPECT_NEAR(term.max_step(x, Vector3d(0.05, 0.0, -1e-3)), 0.09, 1e-12);
+  EXPECT_NEAR(term.max_step(x, Vector3d(0.0, 0.0, -1e-5)), 1.0, 0.0);
+  // Far from the plane the step is whole unless it reaches it.
+  const Vector3d above(0.0, 0.0, 0.5);
+  EXPECT_EQ(term.max_step(above, Vector3d(3.0, 0.0, -0.2)), 1.0);
+  EXPECT_NEAR(term.max_step(above, Vector3d(0.0, 0.0, -2.0)), 0.9 * (0.5 + distance) / 2.0, 1e-12);
+}
+
+TEST(ContactStepFilter, NoStepCrossesAThinWallOrLeavesACavity) {
+  const double distance = 0.01;
+  // A wall |x| < 5 d̂ thick in x, and a point 0.2 m in front of it moving 1 m through it.
+  Obstacle wall;
+  wall.name = "wall";
+  wall.distance = [&](const Vector3d& p, Vector3d& gradient) {
+    gradient = Vector3d(p(0) < 0.0 ? -1.0 : 1.0, 0.0, 0.0);
+    return std::abs(p(0)) - 5 * distance;
+  };
+  // Free space inside a sphere of radius 1: a point 0.99 d̂ into its wall, sliding along it.
+  Obstacle cavity;
+  cavity.name = "cavity";
+  cavity.distance = [](const Vector3d& p, Vector3d& gradient) {
+    gradient = -p.normalized();
+    return 1.0 - p.norm();
+  };
+  const struct {
+    const Obstacle* obstacle;
+    Vector3d x, step;
+  } cases[] = {{&wall, Vector3d(-0.2, 0.0, 0.0), Vector3d(1.0, 0.0, 2.0)},
+               {&wall, Vector3d(-0.2, 0.0, 0.0), Vector3d(1.0, 3.0, 0.0)},
+               {&cavity, Vector3d(0.0, 0.0, 1.0 + 0.99 * distance), Vector3d(0.1, 0.0, 0.0)},
+               {&cavity, Vector3d(0.0, 0.0, 1.0 + 0.99 * distance), Vector3d(0.0, 0.3, 0.0)}};
+  for (const auto& c : cases) {
+    const std::vector<Obstacle> obstacles = {*c.obstacle};
+    const ContactTerm term(obstacles, std::vector<int>{0}, {distance, 50.0, 1e-4});
+    const double r0 = room(*c.obstacle, c.x, distance);
+    const double alpha = term.max_step(c.x, c.step);
+    SCOPED_TRACE(c.obstacle->name + " step " + std::to_string(c.step.norm()));
+    // Not held back to the Lipschitz bound, and stopped before the room is gone: along the
+    // whole path to α (sampled densely) the point stays out of the depth d̂.
+    EXPECT_GT(alpha, 1.4 * 0.9 * r0 / c.step.norm());
+    EXPECT_LT(alpha, 1.0);
+    double least = r0;
+    for (int k = 1; k <= 10000; ++k)
+      least = std::min(least, room(*c.obstacle, c.x + (alpha * k / 10000.0) * c.step, distance));
+    EXPECT_GT(least, 0.0);
+    EXPECT_LT(room(*c.obstacle, c.x + alpha * c.step, distance), 0.5 * r0);
+  }
+}
+
 TEST(ContactScenes, BlockPressedOntoAPlaneCarriesTheLoad) {
   DirichletSpec roller;
   roller.name = "roller";

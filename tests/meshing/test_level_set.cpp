@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
 
 #include "core/io_test_utils.hpp"
@@ -147,6 +148,86 @@ TEST(LevelSet, SmoothSamplingReproducesALinearFieldAndTheVoxelValues) {
     const Vector3d centre = (p / kVoxel).array().round().matrix() * kVoxel;
     EXPECT_NEAR(level_set.smooth_signed_distance_and_gradient(centre, gradient),
                 level_set.signed_distance(centre), 1e-9);
+  }
+}
+
+/// Catmull-Rom through samples at −1, 0, 1, 2, evaluated at t ∈ [0, 1) (Hermite form) and its
+/// derivative in t.
+double catmull_rom(const double f[4], double t, double& derivative) {
+  const double a = 2.0 * f[1], b = f[2] - f[0], c = 2.0 * f[0] - 5.0 * f[1] + 4.0 * f[2] - f[3],
+               d = -f[0] + 3.0 * f[1] - 3.0 * f[2] + f[3];
+  derivative = 0.5 * (b + 2.0 * c * t + 3.0 * d * t * t);
+  return 0.5 * (a + b * t + c * t * t + d * t * t * t);
+}
+
+TEST(LevelSet, SmoothSamplingIsTheTricubicOfTheVoxelValuesEverywhere) {
+  // Points inside the band, beyond it inside and outside the sphere, and far from it (where the
+  // sampler answers the background without reading voxels): each against the tricubic
+  // Catmull-Rom of its 4³ voxel values, read one by one at the voxel centres.
+  const LevelSet sphere = level_set_sphere(kCenter, kRadius, {kVoxel, 4.0});
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coordinate(-kRadius - 12 * kVoxel, kRadius + 12 * kVoxel);
+  int outside_band = 0;
+  for (int i = 0; i < 400; ++i) {
+    Vector3d p = kCenter + Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+    if (i % 4 == 0) p = kCenter + (kRadius + 5.5 * kVoxel) * random_direction(rng);
+    if (i % 4 == 1) p = kCenter + (kRadius + 0.9 * kVoxel) * random_direction(rng);
+    const Vector3d index = p / kVoxel;
+    const Vector3d base = index.array().floor().matrix();
+    const Vector3d t = index - base;
+    double voxels[4][4][4];
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int c = 0; c < 4; ++c)
+          voxels[a][b][c] = sphere.signed_distance(kVoxel * (base + Vector3d(a - 1, b - 1, c - 1)));
+    // Along z, then y, then x.
+    double plane[4][4], plane_dz[4][4], line[4], line_dy[4], line_dz[4];
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        plane[a][b] = catmull_rom(voxels[a][b], t(2), plane_dz[a][b]);
+    for (int a = 0; a < 4; ++a) {
+      double unused;
+      line[a] = catmull_rom(plane[a], t(1), line_dy[a]);
+      line_dz[a] = catmull_rom(plane_dz[a], t(1), unused);
+    }
+    Vector3d expected_gradient;
+    const double expected = catmull_rom(line, t(0), expected_gradient(0));
+    double unused;
+    expected_gradient(1) = catmull_rom(line_dy, t(0), unused);
+    expected_gradient(2) = catmull_rom(line_dz, t(0), unused);
+    expected_gradient /= kVoxel;
+    Vector3d gradient;
+    const double value = sphere.smooth_signed_distance_and_gradient(p, gradient);
+    EXPECT_NEAR(value, expected, 1e-12) << "at " << p.transpose();
+    EXPECT_LT((gradient - expected_gradient).norm(), 1e-9) << "at " << p.transpose();
+    outside_band += std::abs((p - kCenter).norm() - kRadius) > 4 * kVoxel;
+  }
+  EXPECT_GT(outside_band, 50);
+  // Beyond the grid's leaves (8³ voxels each, around the band of 4), on a cube 20–40 voxels
+  // out: the background itself, with a zero gradient.
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), scale(1.0, 2.0);
+  for (int i = 0; i < 100; ++i) {
+    Vector3d u(unit(rng), unit(rng), unit(rng));
+    u /= u.lpNorm<Eigen::Infinity>();
+    const Vector3d p = kCenter + scale(rng) * (kRadius + 20 * kVoxel) * u;
+    Vector3d gradient;
+    EXPECT_EQ(sphere.smooth_signed_distance_and_gradient(p, gradient), sphere.background());
+    EXPECT_EQ(gradient, Vector3d::Zero());
+  }
+}
+
+TEST(LevelSet, SmoothSamplingFarAwayIsTheBackgroundAndOfANonFinitePointNotANumber) {
+  const LevelSet sphere = level_set_sphere(kCenter, kRadius, {kVoxel, 4.0});
+  Vector3d gradient;
+  // Far beyond any voxel index an int can hold.
+  EXPECT_EQ(sphere.smooth_signed_distance_and_gradient(Vector3d(1e300, 0.0, -1e300), gradient),
+            sphere.background());
+  EXPECT_EQ(gradient, Vector3d::Zero());
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    EXPECT_TRUE(
+        std::isnan(sphere.smooth_signed_distance_and_gradient(Vector3d(0.0, bad, 0.0), gradient)));
+    EXPECT_TRUE(gradient.array().isNaN().all());
   }
 }
 
