@@ -77,7 +77,8 @@ openvdb::FloatGrid::Ptr empty_grid() {
 
 LevelSet::Impl::Impl(openvdb::FloatGrid::Ptr level_set) : grid(std::move(level_set)) {
   const openvdb::FloatTree& tree = grid->tree();
-  tree.evalLeafBoundingBox(extent);
+  for (openvdb::FloatTree::LeafCIter leaf = tree.cbeginLeaf(); leaf; ++leaf)
+    extent.expand(leaf->getNodeBoundingBox());  // active or not: any voxel may differ
   const float background = tree.background();
   openvdb::FloatTree::ValueAllCIter tile = tree.cbeginValueAll();
   tile.setMaxDepth(openvdb::FloatTree::ValueAllCIter::LEAF_DEPTH - 1);  // tiles, not voxels
@@ -157,15 +158,15 @@ void catmull_rom_weights(double t, double w[4], double dw[4]) {
 double LevelSet::smooth_signed_distance_and_gradient(const Vector3d& p, Vector3d& gradient) const {
   const openvdb::FloatGrid& grid = *m_impl->grid;
   const openvdb::Vec3d x = grid.transform().worldToIndex(openvdb::Vec3d(p(0), p(1), p(2)));
+  if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2])) {
+    gradient.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   // The stencil reads the voxels floor(x) − 1 … floor(x) + 2 on each axis: where they all lie
   // outside the extent, they all hold the background, and so does the interpolant.
   const openvdb::CoordBBox& extent = m_impl->extent;
   for (int a = 0; a < 3; ++a) {
     const double below = std::floor(x[a]);
-    if (!std::isfinite(below)) {
-      gradient.setConstant(std::numeric_limits<double>::quiet_NaN());
-      return std::numeric_limits<double>::quiet_NaN();
-    }
     if (extent.empty() || !(below + 2.0 >= extent.min()[a] && below - 1.0 <= extent.max()[a])) {
       gradient.setZero();
       return grid.background();

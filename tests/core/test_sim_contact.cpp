@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
@@ -141,7 +142,7 @@ TEST(ContactStepFilter, APointInContactSlidesAndOneMovingInStopsAtATenthOfItsRoo
 
 TEST(ContactStepFilter, NoStepCrossesAThinWallOrLeavesACavity) {
   const double distance = 0.01;
-  // A wall |x| < 5 d̂ thick in x, and a point 0.2 m in front of it moving 1 m through it.
+  // A wall |x| < 5 d̂ (10 d̂ thick), and a point 0.2 m in front of it moving 1 m through it.
   Obstacle wall;
   wall.name = "wall";
   wall.distance = [&](const Vector3d& p, Vector3d& gradient) {
@@ -178,6 +179,55 @@ TEST(ContactStepFilter, NoStepCrossesAThinWallOrLeavesACavity) {
     EXPECT_GT(least, 0.0);
     EXPECT_LT(room(*c.obstacle, c.x + alpha * c.step, distance), 0.5 * r0);
   }
+}
+
+TEST(ContactStepFilter, KeepsAtLeastATwentiethOfTheRoomAlongRandomStepsNearCurvedSurfaces) {
+  // Points within 2 d̂ of a sphere of radius 1 (outside it) and of a spherical cavity (inside
+  // it), with random steps up to 0.5 m: along the filtered path (sampled densely) no point
+  // enters the depth d̂, and at its end each keeps at least a twentieth of its room. Along a
+  // path past a sphere r(t) is convex, where interpolating between samples overshoots.
+  const double distance = 0.01;
+  const std::vector<Obstacle> obstacles = {sphere_obstacle(Vector3d::Zero(), 1.0)};
+  Obstacle cavity;
+  cavity.name = "cavity";
+  cavity.distance = [](const Vector3d& p, Vector3d& gradient) {
+    gradient = -p.normalized();
+    return 1.0 - p.norm();
+  };
+  const std::vector<Obstacle> cavities = {cavity};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), depth(-0.99, 2.0), reach(0.0, 0.5);
+  const auto direction = [&] {
+    Vector3d d(unit(rng), unit(rng), unit(rng));
+    return d.normalized();
+  };
+  int limited = 0;
+  for (int i = 0; i < 400; ++i) {
+    const bool inside = i % 2 == 1;
+    const std::vector<Obstacle>& set = inside ? cavities : obstacles;
+    const Vector3d x = (1.0 + (inside ? -1.0 : 1.0) * depth(rng) * distance) * direction();
+    const Vector3d step = reach(rng) * direction();
+    const ContactTerm term(set, std::vector<int>{0}, {distance, 50.0, 1e-4});
+    const double r0 = room(set[0], x, distance);
+    const double alpha = term.max_step(x, step);
+    ASSERT_GT(alpha, 0.0);
+    limited += alpha < 1.0;
+    double least = r0;
+    for (int k = 1; k <= 2000; ++k)
+      least = std::min(least, room(set[0], x + (alpha * k / 2000.0) * step, distance));
+    EXPECT_GT(least, 0.0) << "case " << i;
+    EXPECT_GE(room(set[0], x + alpha * step, distance), 0.05 * r0) << "case " << i;
+  }
+  EXPECT_GT(limited, 100);
+  // A step that sinks slowly while it slides over the top of the sphere, from 0.99 d̂ deep: r(t)
+  // is convex, and between the samples around its crossing of r₀/10 the interpolated α lies
+  // past r = 0 (r(α) = −0.03 r₀ without the halving).
+  const Vector3d top(0.0, 0.0, 1.0 - distance + 1e-4);
+  const Vector3d sinking(0.03, 0.0, -6.9e-4);
+  const ContactTerm term(obstacles, std::vector<int>{0}, {distance, 50.0, 1e-4});
+  const double alpha = term.max_step(top, sinking);
+  EXPECT_GE(room(obstacles[0], top + alpha * sinking, distance), 0.05e-4);
+  EXPECT_GT(alpha, 0.9e-4 / sinking.norm());
 }
 
 TEST(ContactScenes, BlockPressedOntoAPlaneCarriesTheLoad) {

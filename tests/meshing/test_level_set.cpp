@@ -160,10 +160,43 @@ double catmull_rom(const double f[4], double t, double& derivative) {
   return 0.5 * (a + b * t + c * t * t + d * t * t * t);
 }
 
+/// The sampler's value and gradient at p against the tricubic Catmull-Rom of the 4³ voxel values
+/// around p, read one by one at the voxel centres (where the trilinear sampler is the voxel's
+/// value); returns the value.
+double expect_tricubic_of_voxels(const LevelSet& level_set, const Vector3d& p) {
+  const Vector3d index = p / kVoxel;
+  const Vector3d base = index.array().floor().matrix();
+  const Vector3d t = index - base;
+  double voxels[4][4][4];
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      for (int c = 0; c < 4; ++c)
+        voxels[a][b][c] =
+            level_set.signed_distance(kVoxel * (base + Vector3d(a - 1, b - 1, c - 1)));
+  // Along z, then y, then x.
+  double plane[4][4], plane_dz[4][4], line[4], line_dy[4], line_dz[4], unused;
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      plane[a][b] = catmull_rom(voxels[a][b], t(2), plane_dz[a][b]);
+  for (int a = 0; a < 4; ++a) {
+    line[a] = catmull_rom(plane[a], t(1), line_dy[a]);
+    line_dz[a] = catmull_rom(plane_dz[a], t(1), unused);
+  }
+  Vector3d expected_gradient;
+  const double expected = catmull_rom(line, t(0), expected_gradient(0));
+  expected_gradient(1) = catmull_rom(line_dy, t(0), unused);
+  expected_gradient(2) = catmull_rom(line_dz, t(0), unused);
+  expected_gradient /= kVoxel;
+  Vector3d gradient;
+  const double value = level_set.smooth_signed_distance_and_gradient(p, gradient);
+  EXPECT_NEAR(value, expected, 1e-12) << "at " << p.transpose();
+  EXPECT_LT((gradient - expected_gradient).norm(), 1e-9) << "at " << p.transpose();
+  return value;
+}
+
 TEST(LevelSet, SmoothSamplingIsTheTricubicOfTheVoxelValuesEverywhere) {
   // Points inside the band, beyond it inside and outside the sphere, and far from it (where the
-  // sampler answers the background without reading voxels): each against the tricubic
-  // Catmull-Rom of its 4³ voxel values, read one by one at the voxel centres.
+  // sampler answers the background without reading voxels).
   const LevelSet sphere = level_set_sphere(kCenter, kRadius, {kVoxel, 4.0});
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> coordinate(-kRadius - 12 * kVoxel, kRadius + 12 * kVoxel);
@@ -172,34 +205,7 @@ TEST(LevelSet, SmoothSamplingIsTheTricubicOfTheVoxelValuesEverywhere) {
     Vector3d p = kCenter + Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
     if (i % 4 == 0) p = kCenter + (kRadius + 5.5 * kVoxel) * random_direction(rng);
     if (i % 4 == 1) p = kCenter + (kRadius + 0.9 * kVoxel) * random_direction(rng);
-    const Vector3d index = p / kVoxel;
-    const Vector3d base = index.array().floor().matrix();
-    const Vector3d t = index - base;
-    double voxels[4][4][4];
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int c = 0; c < 4; ++c)
-          voxels[a][b][c] = sphere.signed_distance(kVoxel * (base + Vector3d(a - 1, b - 1, c - 1)));
-    // Along z, then y, then x.
-    double plane[4][4], plane_dz[4][4], line[4], line_dy[4], line_dz[4];
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        plane[a][b] = catmull_rom(voxels[a][b], t(2), plane_dz[a][b]);
-    for (int a = 0; a < 4; ++a) {
-      double unused;
-      line[a] = catmull_rom(plane[a], t(1), line_dy[a]);
-      line_dz[a] = catmull_rom(plane_dz[a], t(1), unused);
-    }
-    Vector3d expected_gradient;
-    const double expected = catmull_rom(line, t(0), expected_gradient(0));
-    double unused;
-    expected_gradient(1) = catmull_rom(line_dy, t(0), unused);
-    expected_gradient(2) = catmull_rom(line_dz, t(0), unused);
-    expected_gradient /= kVoxel;
-    Vector3d gradient;
-    const double value = sphere.smooth_signed_distance_and_gradient(p, gradient);
-    EXPECT_NEAR(value, expected, 1e-12) << "at " << p.transpose();
-    EXPECT_LT((gradient - expected_gradient).norm(), 1e-9) << "at " << p.transpose();
+    expect_tricubic_of_voxels(sphere, p);
     outside_band += std::abs((p - kCenter).norm() - kRadius) > 4 * kVoxel;
   }
   EXPECT_GT(outside_band, 50);
@@ -214,6 +220,23 @@ TEST(LevelSet, SmoothSamplingIsTheTricubicOfTheVoxelValuesEverywhere) {
     EXPECT_EQ(sphere.smooth_signed_distance_and_gradient(p, gradient), sphere.background());
     EXPECT_EQ(gradient, Vector3d::Zero());
   }
+}
+
+TEST(LevelSet, SmoothSamplingReadsTheInsideFarFromTheBand) {
+  // The half-space z < 0 in a box: the grid holds leaves only near z = 0; deep below, its inside
+  // is held by tiles of −background, far from every leaf. The sampler must read them there.
+  const LevelSet half_space =
+      level_set_from_function([](const Vector3d& p) { return p(2); }, Vector3d(-0.3, -0.3, -0.3),
+                              Vector3d(0.3, 0.3, 0.3), {kVoxel, 4.0}, "half-space");
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> tangential(-0.25, 0.25), normal(-0.6, 0.6);
+  int deep_inside = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Vector3d p(tangential(rng), tangential(rng), normal(rng));
+    const double value = expect_tricubic_of_voxels(half_space, p);
+    deep_inside += p(2) < -0.2 && std::abs(value + half_space.background()) < 1e-12;
+  }
+  EXPECT_GT(deep_inside, 20);
 }
 
 TEST(LevelSet, SmoothSamplingFarAwayIsTheBackgroundAndOfANonFinitePointNotANumber) {

@@ -201,9 +201,11 @@ double ContactTerm::max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) cons
   // r(t) ≥ r₀ − t‖Δx‖: no point needs a closer look while 0.9 r₀ / ‖Δx‖ ≥ α. A point that would
   // limit α by that bound (a point in contact, sliding) is followed along its path: jumps of
   // 0.9 r (which cannot cross the surface) while it is far, samples d̂ apart near the surface,
-  // and α where r falls to a tenth of r₀ (interpolated between samples).
+  // and α where r falls to a tenth of r₀ (interpolated between samples, then halved towards the
+  // last sample until r there is above a twentieth of r₀).
   constexpr double kKeep = 0.1;      // the fraction of its room a point keeps
   constexpr int kMaxSamples = 4096;  // per point and obstacle
+  constexpr int kMaxHalvings = 30;
   const double spacing = m_settings.distance;
   double alpha = 1.0;
   for (const Obstacle& obstacle : m_obstacles)
@@ -213,17 +215,26 @@ double ContactTerm::max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) cons
       if (length == 0.0) continue;
       const Vector3d start = position(q, p);
       Vector3d n;
-      const double room = obstacle.distance_at(start, m_time, n) + m_settings.distance;
+      const auto room_at = [&](double t) {
+        return obstacle.distance_at(start + t * move, m_time, n) + m_settings.distance;
+      };
+      const double room = room_at(0.0);
       if (!(room > 0.0) || (1.0 - kKeep) * room >= alpha * length) continue;
       const double target = kKeep * room;
-      double t = 0.0, r = room;
+      double t = 0.0, r = room;  // the last sample, r > target
       for (int sample = 0; sample < kMaxSamples && t < alpha; ++sample) {
         const double next_t = std::min(alpha, t + std::max(0.9 * r, spacing) / length);
-        const double next_r =
-            obstacle.distance_at(start + next_t * move, m_time, n) + m_settings.distance;
-        if (!(next_r > target)) {
+        const double next_r = room_at(next_t);
+        if (!std::isfinite(next_r)) {
+          alpha = t;
+          break;
+        }
+        if (next_r <= target) {
           // r crosses the target between t and next_t (r > target ≥ next_r).
-          alpha = std::isfinite(next_r) ? t + (next_t - t) * (r - target) / (r - next_r) : t;
+          double end = t + (next_t - t) * (r - target) / (r - next_r);
+          for (int halving = 0; halving < kMaxHalvings && !(room_at(end) > 0.5 * target); ++halving)
+            end = t + 0.5 * (end - t);
+          alpha = std::min(alpha, end);
           break;
         }
         t = next_t;

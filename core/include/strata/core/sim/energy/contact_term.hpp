@@ -63,12 +63,13 @@ class ContactTerm final : public EnergyTerm {
   /// exact and projected coincide.
   void add_hessian(ConstRef<VectorXd> q, SparseMatrixd& hessian, bool project_psd) const override;
 
-  /// Step filter: the largest α ≤ 1 at which no point has closed its room r = φ + d̂ (to the
-  /// depth d̂) to less than a tenth of its start. φ is 1-Lipschitz, so a point moving by
-  /// ‖αΔx‖ ≤ 0.9 r₀ cannot, and only the others are followed along their path: a point moving
-  /// straight in stops at 0.9 r₀ / ‖Δx‖ as before, a point sliding along the surface is not held
-  /// back by its small room. Samples near the surface are d̂ apart: a surface feature thinner than
-  /// d̂ across the path may be missed (the line search still refuses an infeasible end).
+  /// Step filter: about the largest α ≤ 1 at which no point has closed its room r = φ + d̂ (to
+  /// the depth d̂) to less than a tenth of its start (at least a twentieth is kept). φ is
+  /// 1-Lipschitz, so a point moving by ‖αΔx‖ ≤ 0.9 r₀ cannot, and only the others are followed
+  /// along their path: a point moving straight in stops at 0.9 r₀ / ‖Δx‖ as before, a point
+  /// sliding along the surface is not held back by its small room. Samples near the surface are
+  /// d̂ apart: an obstacle part less than about 3 d̂ thick across the path may be crossed in one
+  /// step (the end of a step is always checked: the line search refuses an infeasible one).
   double max_step(ConstRef<VectorXd> q, ConstRef<VectorXd> step) const override;
   /// Adds the barrier's (normal) contact forces −∂b/∂q at the end-of-step placement into `f`;
   /// returns the vertex–obstacle pairs in contact (φ < 0).
