@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "cli_test_utils.hpp"
 #include "strata/core/io/vtu.hpp"
@@ -258,6 +259,15 @@ double adaptive_error(const TempFolder& folder, const json& scene) {
   return probe_error(folder.path() / "adaptive", folder.path() / "full");
 }
 
+/// The times of the adaptive run's cut changes that merged nodes (folder/adaptive/stats.json).
+std::vector<double> merge_times(const TempFolder& folder) {
+  const json stats = read_json(folder.path() / "adaptive" / "stats.json");
+  std::vector<double> times;
+  for (const json& change : stats["hierarchy"]["changes"])
+    if (change["coarsened"].get<int>() > 0) times.push_back(change["time"].get<double>());
+  return times;
+}
+
 TEST(CliHierarchy, AStaticRunWhosePassesOutgrowTheEstimateRefinesOn) {
   // A slender rod (2 × 2 × 40 cm, 2 × 2 × 20 cells) clamped at its base, its top pushed down
   // 2.5 mm (about 0.76 of its buckling load) and a small side load at mid-height: the coarse
@@ -323,12 +333,8 @@ TEST(CliHierarchy, NoMergeMeetsAPrescribedMotionAboutToStart) {
   const double error = adaptive_error(folder, scene);
   EXPECT_LE(error, 0.01);
   // No merge within the lock (10 steps, 20 ms) before the motion starts, nor while it grows.
-  const json stats = read_json(folder.path() / "adaptive" / "stats.json");
-  for (const json& change : stats["hierarchy"]["changes"]) {
-    if (change["coarsened"].get<int>() == 0) continue;
-    const double t = change["time"].get<double>();
+  for (const double t : merge_times(folder))
     EXPECT_TRUE(t <= 0.02 + 1e-9 || t >= 0.07 - 1e-9) << "a merge at t = " << t;
-  }
 }
 
 TEST(CliHierarchy, APulseThatComesBackMeetsTheCutItsPeakNeeds) {
@@ -355,13 +361,8 @@ TEST(CliHierarchy, APulseThatComesBackMeetsTheCutItsPeakNeeds) {
   EXPECT_LE(adaptive_error(folder, scene), 0.01);
   // Every node this run refined is the floor's: none merges while the load rests (the merges
   // at the first pulse's peak are judged with the load acting).
-  const json stats = read_json(folder.path() / "adaptive" / "stats.json");
-  for (const json& change : stats["hierarchy"]["changes"]) {
-    const double t = change["time"].get<double>();
-    if (change["coarsened"].get<int>() > 0) {
-      EXPECT_TRUE(t <= 0.04 + 1e-9 || t >= 0.17 - 1e-9) << "a merge at t = " << t;
-    }
-  }
+  for (const double t : merge_times(folder))
+    EXPECT_TRUE(t <= 0.04 + 1e-9 || t >= 0.17 - 1e-9) << "a merge at t = " << t;
 }
 
 TEST(CliHierarchy, AWeakPatchBesideAStrongOneStaysWithinTheTolerance) {
