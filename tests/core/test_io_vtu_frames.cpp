@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "io_test_utils.hpp"
 #include "strata/core/common/error.hpp"
@@ -107,6 +110,54 @@ TEST(IoVtuFrames, ArraysOfManyCompressedBlocksReadBackAndDoNotDependOnTheThreads
   const VtkFrame frame = read_vtk_frame(dir / "threads.vtu");
   EXPECT_TRUE((frame.cell_field("stress").array() == stress.array()).all());
   EXPECT_TRUE((frame.points.array() == mesh.vertices.array()).all());
+}
+
+/// The deflate block types (0 stored, 1 fixed, 2 dynamic Huffman) that begin the zlib blocks of
+/// the appended array `name` in a binary .vtu.
+std::vector<int> deflate_block_types(const std::string& text, const std::string& name) {
+  const std::size_t tag = text.find("Name=\"" + name + "\"");
+  const std::size_t offset_at = text.find("offset=\"", tag) + 8;
+  const std::size_t offset = std::stoull(text.substr(offset_at, text.find('"', offset_at)));
+  const std::size_t data = text.find('_', text.find("<AppendedData")) + 1 + offset;
+  const auto word = [&](std::size_t i) {
+    std::uint64_t value = 0;
+    std::memcpy(&value, text.data() + data + 8 * i, sizeof value);
+    return static_cast<std::size_t>(value);
+  };
+  std::vector<int> types;
+  std::size_t at = data + 8 * (3 + word(0));
+  for (std::size_t b = 0; b < word(0); ++b) {
+    // Two bytes of zlib header, then the first deflate block's header: BFINAL, then BTYPE.
+    types.push_back((static_cast<unsigned char>(text[at + 2]) >> 1) & 3);
+    at += word(3 + b);
+  }
+  return types;
+}
+
+TEST(IoVtuFrames, ArraysThatDoNotDeflateAreStoredAndReadBackExactly) {
+  ScratchDir dir("io_frame_stored");
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {10, 10, 20});
+  const Index nt = mesh.tets.rows();
+  VtuFields fields;
+  const Eigen::MatrixXd stress = 1e6 * Eigen::MatrixXd::Random(nt, 6);  // nine blocks of noise
+  Eigen::MatrixXd strain = Eigen::MatrixXd::Zero(nt, 6);
+  strain.col(2).setConstant(1e-3);
+  strain.bottomRows(nt / 2) = 1e-3 * Eigen::MatrixXd::Random(nt / 2, 6);  // noise after zeros
+  fields.add_cell_data("stress", stress);
+  fields.add_cell_data("green_strain", strain);
+  write_vtu(dir / "f.vtu", mesh.vertices, mesh.tets, fields, VtkEncoding::binary);
+  const std::string text = read_text(dir / "f.vtu");
+  // The noise is stored after its first block (which decides, and is kept deflated); the strain,
+  // whose first block deflates, is deflated throughout (its noisy half too), as is the
+  // connectivity.
+  const std::vector<int> stress_types = deflate_block_types(text, "stress");
+  ASSERT_EQ(stress_types.size(), 9u);
+  EXPECT_THAT(std::vector<int>(stress_types.begin() + 1, stress_types.end()), ::testing::Each(0));
+  EXPECT_THAT(deflate_block_types(text, "green_strain"), ::testing::Each(::testing::Gt(0)));
+  EXPECT_THAT(deflate_block_types(text, "connectivity"), ::testing::Each(::testing::Gt(0)));
+  const VtkFrame frame = read_vtk_frame(dir / "f.vtu");
+  EXPECT_TRUE((frame.cell_field("stress").array() == stress.array()).all());
+  EXPECT_TRUE((frame.cell_field("green_strain").array() == strain.array()).all());
 }
 
 TEST(IoVtuFrames, FieldWithWrongRowCountIsInputErrorNamingIt) {

@@ -65,6 +65,8 @@ void check_field_rows(const std::filesystem::path& path, const VtuFields& fields
 namespace {
 
 constexpr std::size_t kBlockSize = 1 << 16;  ///< uncompressed bytes per zlib block
+/// An array whose first block deflates to more than this share of its size is stored.
+constexpr double kStoreRatio = 0.8;
 
 template <typename T>
 const char* type_name() {
@@ -106,21 +108,33 @@ void DataArrayWriter::begin_file(std::ostream& out, const char* type) const {
 
 void DataArrayWriter::append_compressed(const std::uint8_t* data, std::size_t size) {
   const std::size_t num_blocks = (size + kBlockSize - 1) / kBlockSize;
-  // The blocks are compressed independently (in parallel, each into a buffer of its own) and
-  // appended in order: the bytes do not depend on the thread count.
   std::vector<std::vector<std::uint8_t>> compressed(num_blocks);
   std::atomic<bool> failed{false};
-  tbb::parallel_for(std::size_t(0), num_blocks, [&](std::size_t b) {
+  const auto compress_block = [&](std::size_t b, int level) {
     const std::size_t begin = b * kBlockSize;
     const std::size_t length = std::min(kBlockSize, size - begin);
     std::vector<std::uint8_t>& block = compressed[b];
     uLongf compressed_size = compressBound(static_cast<uLong>(length));
     block.resize(compressed_size);
     if (compress2(block.data(), &compressed_size, data + begin, static_cast<uLong>(length),
-                  Z_BEST_SPEED) != Z_OK)
+                  level) != Z_OK)
       failed = true;
     block.resize(compressed_size);
-  });
+  };
+  // The first block decides the level of the others: an array whose first block deflates to
+  // more than kStoreRatio of its size (a field of doubles that vary from tet to tet, such as the
+  // stress) is stored in zlib's uncompressed blocks, still a zlib stream to every reader. Storing
+  // costs a copy and a checksum; deflating doubles runs at tens of MB/s to save a few per cent.
+  if (num_blocks > 0) compress_block(0, Z_BEST_SPEED);
+  const double first_length = static_cast<double>(std::min(kBlockSize, size));
+  const int level =
+      num_blocks > 0 && static_cast<double>(compressed[0].size()) > kStoreRatio * first_length
+          ? Z_NO_COMPRESSION
+          : Z_BEST_SPEED;
+  // The other blocks are compressed independently (in parallel, each into a buffer of its own)
+  // and appended in order: the bytes do not depend on the thread count.
+  tbb::parallel_for(std::size_t(1), std::max<std::size_t>(num_blocks, 1),
+                    [&](std::size_t b) { compress_block(b, level); });
   if (failed) throw std::runtime_error("zlib could not compress a VTK data block");
   std::size_t total = 8 * (3 + num_blocks);
   for (const std::vector<std::uint8_t>& block : compressed)
