@@ -39,6 +39,8 @@ bool BlockSymmetricMatrix::assign(const SparseMatrixd& A) {
   }
   m_block_rows.resize(m_outer[num_blocks]);
   m_values.resize(9 * static_cast<std::size_t>(m_outer[num_blocks]));
+  m_single.resize(m_keep_single ? m_values.size() : 0);
+  float* single = m_keep_single ? m_single.data() : nullptr;
   // The rows of each column in triples, the same in the three columns; copied as checked.
   const bool blocked = tbb::parallel_reduce(
       tbb::blocked_range<Index>(0, num_blocks, 512), true,
@@ -60,6 +62,9 @@ bool BlockSymmetricMatrix::assign(const SparseMatrixd& A) {
             for (int j = 0; j < 3; ++j)
               for (int i = 0; i < 3; ++i)
                 entries[3 * j + i] = values[start + j * length + k + i];
+            if (single != nullptr)
+              for (int e = 0; e < 9; ++e)
+                single[9 * static_cast<std::size_t>(block) + e] = static_cast<float>(entries[e]);
           }
         }
         return ok;
@@ -78,6 +83,7 @@ void BlockSymmetricMatrix::clear() {
   m_outer.clear();
   m_block_rows.clear();
   m_values.clear();
+  m_single.clear();
 }
 
 void BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y) const {
@@ -86,13 +92,25 @@ void BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y) const {
 
 double BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y,
                                       const std::function<double(Index, Index)>& after) const {
+  return product(m_values.data(), x, y, after);
+}
+
+double BlockSymmetricMatrix::multiply_single(
+    ConstRef<VectorXd> x, VectorXd& y, const std::function<double(Index, Index)>& after) const {
+  STRATA_VERIFY(has_single_precision(),
+                "BlockSymmetricMatrix::multiply_single: no single-precision values kept");
+  return product(m_single.data(), x, y, after);
+}
+
+template <typename Scalar>
+double BlockSymmetricMatrix::product(const Scalar* values, ConstRef<VectorXd> x, VectorXd& y,
+                                     const std::function<double(Index, Index)>& after) const {
   STRATA_VERIFY(x.size() == rows(), "BlockSymmetricMatrix::multiply: x has the wrong size");
   y.resize(rows());
   const double* xs = x.data();
   double* ys = y.data();
   const int* outer = m_outer.data();
   const int* block_rows = m_block_rows.data();
-  const double* values = m_values.data();
   const Index num_chunks = (m_num_blocks + kBlockChunk - 1) / kBlockChunk;
   std::vector<double> partial(static_cast<std::size_t>(after ? num_chunks : 0));
   // Row 3b + j of the (symmetric) matrix is column 3b + j: entry (i, j) of each block of block
@@ -104,7 +122,7 @@ double BlockSymmetricMatrix::multiply(ConstRef<VectorXd> x, VectorXd& y,
       double y0 = 0.0, y1 = 0.0, y2 = 0.0;
       for (int k = outer[b]; k < outer[b + 1]; ++k) {
         const double* xa = xs + 3 * static_cast<Index>(block_rows[k]);
-        const double* entries = values + 9 * static_cast<std::size_t>(k);
+        const Scalar* entries = values + 9 * static_cast<std::size_t>(k);
         y0 += entries[0] * xa[0] + entries[1] * xa[1] + entries[2] * xa[2];
         y1 += entries[3] * xa[0] + entries[4] * xa[1] + entries[5] * xa[2];
         y2 += entries[6] * xa[0] + entries[7] * xa[1] + entries[8] * xa[2];

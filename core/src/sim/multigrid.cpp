@@ -286,10 +286,19 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     m_levels[k]->owned.swap(coarse);  // Eigen's assignment from a named matrix would copy it
     m_levels[k]->A = &m_levels[k]->owned;
   }
-  // The levels whose operators multiply vectors: the smoothed ones and the finest (CG's).
-  for (int k = 1; k <= L; ++k)
-    m_levels[k]->blocks.assign(*m_levels[k]->A);
-  if (L == 0) m_levels[0]->blocks.assign(A);
+  // The levels whose operators multiply vectors: the smoothed ones and the finest (CG's), the
+  // large ones with a single-precision copy for the cycle's products.
+  for (int k = 1; k <= L; ++k) {
+    const SparseMatrixd& Ak = *m_levels[k]->A;
+    m_levels[k]->blocks.keep_single_precision(m_options.single_precision_cycle &&
+                                              Ak.nonZeros() / 9 >=
+                                                  m_options.single_precision_min_blocks);
+    m_levels[k]->blocks.assign(Ak);
+  }
+  if (L == 0) {
+    m_levels[0]->blocks.keep_single_precision(false);
+    m_levels[0]->blocks.assign(A);
+  }
   for (int k = 1; k <= L; ++k)
     setup_smoother(*m_levels[k]);
   m_sizes.clear();
@@ -384,6 +393,10 @@ std::pair<double, double> MultigridPreconditioner::smoother_interval(int k) cons
 
 bool MultigridPreconditioner::blocked_products(int k) const {
   return !m_levels.at(static_cast<std::size_t>(k))->blocks.empty();
+}
+
+bool MultigridPreconditioner::single_precision_products(int k) const {
+  return m_levels.at(static_cast<std::size_t>(k))->blocks.has_single_precision();
 }
 
 void MultigridPreconditioner::widen_smoother_intervals() {
@@ -501,6 +514,7 @@ void MultigridPreconditioner::cycle(int k, const VectorXd& b, VectorXd& x) const
 
 double MultigridPreconditioner::multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y,
                                          const std::function<double(Index, Index)>& after) {
+  if (level.blocks.has_single_precision()) return level.blocks.multiply_single(x, y, after);
   if (!level.blocks.empty()) return level.blocks.multiply(x, y, after);
   return symmetric_product(*level.A, x, y, after);
 }
@@ -514,7 +528,7 @@ double MultigridPreconditioner::multiply_finest(
     const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y,
     const std::function<double(Index, Index)>& after) const {
   const Level& finest = *m_levels.back();
-  if (&A == finest.A) return multiply(finest, x, y, after);
+  if (&A == finest.A && !finest.blocks.empty()) return finest.blocks.multiply(x, y, after);
   return symmetric_product(A, x, y, after);
 }
 

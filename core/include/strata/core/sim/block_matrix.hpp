@@ -20,6 +20,10 @@ class BlockSymmetricMatrix {
   /// rows, which come in triples 3a, 3a + 1, 3a + 2. Returns false (and holds nothing) otherwise.
   bool assign(const SparseMatrixd& A);
   void clear();
+  /// Whether assign() also keeps the values rounded to single precision (written in the same
+  /// pass), for multiply_single(). Takes effect at the next assign().
+  void keep_single_precision(bool keep) { m_keep_single = keep; }
+  bool has_single_precision() const { return m_num_blocks > 0 && m_keep_single; }
   bool empty() const { return m_num_blocks == 0; }
   Index rows() const { return 3 * m_num_blocks; }
 
@@ -35,12 +39,22 @@ class BlockSymmetricMatrix {
   /// in order: the same at any thread count (0 for an empty `after`).
   double multiply(ConstRef<VectorXd> x, VectorXd& y,
                   const std::function<double(Index, Index)>& after) const;
+  /// The same product by the values rounded to single precision (has_single_precision()), which
+  /// reads 40 bytes per block instead of 76; x, y and the sums stay in double.
+  double multiply_single(ConstRef<VectorXd> x, VectorXd& y,
+                         const std::function<double(Index, Index)>& after) const;
 
  private:
   Index m_num_blocks = 0;
   std::vector<int> m_outer;      ///< block column b: blocks m_outer[b] .. m_outer[b + 1]
   FillVector<int> m_block_rows;  ///< block row a of each block
   FillVector<double> m_values;   ///< 9 per block: entry (i, j) at 3j + i
+  FillVector<float> m_single;    ///< m_values rounded, when m_keep_single
+  bool m_keep_single = false;
+
+  template <typename Scalar>
+  double product(const Scalar* values, ConstRef<VectorXd> x, VectorXd& y,
+                 const std::function<double(Index, Index)>& after) const;
 };
 
 }  // namespace strata
