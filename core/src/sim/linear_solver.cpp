@@ -34,8 +34,8 @@ namespace {
 
 struct TreeCycle final : SpdSolver::Cycle {
   MultigridPreconditioner preconditioner;
-  explicit TreeCycle(std::vector<SparseMatrixd> prolongations)
-      : preconditioner(std::move(prolongations)) {}
+  TreeCycle(std::vector<SparseMatrixd> prolongations, const MultigridOptions& options)
+      : preconditioner(std::move(prolongations), options) {}
   bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
   void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
@@ -53,11 +53,13 @@ struct TreeCycle final : SpdSolver::Cycle {
 /// factorisation are those of the tree's multigrid, on TBB threads.
 struct AlgebraicCycle final : SpdSolver::Cycle {
   std::vector<Index> free_dofs;  ///< of the systems; empty: every vertex whole
+  MultigridOptions cycle_options;
   std::unique_ptr<MultigridPreconditioner> cycle;
   Index rows = -1;
   double seconds = 0.0;
 
-  explicit AlgebraicCycle(std::vector<Index> dofs) : free_dofs(std::move(dofs)) {}
+  AlgebraicCycle(std::vector<Index> dofs, const MultigridOptions& options)
+      : free_dofs(std::move(dofs)), cycle_options(options) {}
   bool setup(const SparseMatrixd& A) override {
     const auto start = std::chrono::steady_clock::now();
     bool ok = true;
@@ -76,7 +78,7 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
       if (ok) prolongations = amg.prolongations();
       ok = ok && !prolongations.empty();  // too small to coarsen
       if (ok) {
-        cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations));
+        cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations), cycle_options);
         rows = A.rows();
       }
     }
@@ -135,7 +137,8 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
   m_free_dofs = free_dofs;
   if (multigrid) {
     m_kind = LinearSolverKind::multigrid;
-    m_multigrid = std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs));
+    m_multigrid =
+        std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs), m_cycle_options);
   } else if (requested == LinearSolverKind::amg) {
     use_algebraic_multigrid();
   } else if (requested == LinearSolverKind::automatic) {
@@ -148,7 +151,7 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
 
 void SpdSolver::use_algebraic_multigrid() {
   m_kind = LinearSolverKind::amg;
-  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_dofs);
+  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_dofs, m_cycle_options);
   m_multigrid_stale = true;
 }
 

@@ -71,6 +71,8 @@ class SpdSolver {
   double relative_tolerance() const { return m_relative_tolerance; }
   /// Iteration limit of multigrid-PCG (default 500) before it falls back to CHOLMOD.
   void set_max_iterations(int iterations) { m_max_iterations = iterations; }
+  /// The options of the multigrid cycles (tree and algebraic) built after this call.
+  void set_multigrid_options(const MultigridOptions& options) { m_cycle_options = options; }
 
   /// The solver in use (never `automatic`).
   LinearSolverKind kind() const { return m_kind; }
@@ -114,6 +116,7 @@ class SpdSolver {
   double m_factor_flops_per_nonzero = 0.0;  ///< of the last analysis
   double m_relative_tolerance = 1e-10;
   int m_max_iterations = 500;
+  MultigridOptions m_cycle_options;
   Index m_multigrid_rows = -1;
   Index m_multigrid_nonzeros = -1;
   long m_direct_fallbacks = 0;
