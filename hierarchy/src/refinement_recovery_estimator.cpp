@@ -102,9 +102,14 @@ double local_share_removed(int depth, int level) {
   return 1.0 - std::ldexp(1.0, -(depth - level));
 }
 
-/// |e| = √(e:e) of a symmetric tensor in Voigt form [xx yy zz xy yz xz].
+/// e:e of a symmetric tensor in Voigt form [xx yy zz xy yz xz].
+double frobenius_sq(const Vector6d& e) {
+  return e.head<3>().squaredNorm() + 2.0 * e.tail<3>().squaredNorm();
+}
+
+/// |e| = √(e:e).
 double frobenius(const Vector6d& e) {
-  return std::sqrt(e.head<3>().squaredNorm() + 2.0 * e.tail<3>().squaredNorm());
+  return std::sqrt(frobenius_sq(e));
 }
 
 /// The predicted local term δ of the parent (level `parent_level`) of eight sibling flat tets
@@ -185,13 +190,14 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
     for (Index t = begin; t < end; ++t) {
       const Vector6d own = strain.row(t).transpose();
       Vector6d sum = Vector6d::Zero();
-      double vertex_terms = 0.0, largest_difference = 0.0;
+      double vertex_terms = 0.0, largest_difference_sq = 0.0;
       for (int k = 0; k < 4; ++k) {
         const Vector6d d = recovered.row(mesh.tets(t, k)).head<6>().transpose() - own;
         vertex_terms += twice_energy_density(d, lame);
         sum += d;
-        largest_difference = std::max(largest_difference, frobenius(d));
+        largest_difference_sq = std::max(largest_difference_sq, frobenius_sq(d));
       }
+      const double largest_difference = std::sqrt(largest_difference_sq);
       const double error_sq = volume[t] / 20.0 * (vertex_terms + twice_energy_density(sum, lame));
       const int level = state.flat.tet_levels[t];
       estimate.element_error_sq[t] = error_sq * removed[level] * removed[level];
