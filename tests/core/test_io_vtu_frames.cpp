@@ -91,8 +91,9 @@ TEST(IoVtuFrames, BothEncodingsReadBackTheIdenticalArrays) {
 }
 
 TEST(IoVtuFrames, ArraysOfManyCompressedBlocksReadBackAndDoNotDependOnTheThreads) {
-  // 12,000 tets: the stress array is 576,000 bytes, nine zlib blocks of 64 KiB, compressed in
-  // parallel and appended in order.
+  // 12,000 tets: the stress array is 576,000 bytes, nine zlib blocks of 64 KiB (noise: stored
+  // after its first), and a smooth strain of as many blocks, deflated in parallel; both appended
+  // in order.
   if (max_threads() < 2) GTEST_SKIP() << "one thread: nothing to compare";
   ScratchDir dir("io_frame_blocks");
   const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {10, 10, 20});
@@ -100,7 +101,11 @@ TEST(IoVtuFrames, ArraysOfManyCompressedBlocksReadBackAndDoNotDependOnTheThreads
   ASSERT_GT(6 * nt * static_cast<Index>(sizeof(double)), 8 * 65536);
   VtuFields fields;
   const Eigen::MatrixXd stress = 1e6 * Eigen::MatrixXd::Random(nt, 6);
+  Eigen::MatrixXd strain(nt, 6);
+  for (Index t = 0; t < nt; ++t)
+    strain.row(t).setConstant(1e-3 * static_cast<double>(t / 16));
   fields.add_cell_data("stress", stress);
+  fields.add_cell_data("green_strain", strain);
   write_vtu(dir / "threads.vtu", mesh.vertices, mesh.tets, fields, VtkEncoding::binary);
   {
     const ThreadLimit serial(1);
@@ -109,6 +114,7 @@ TEST(IoVtuFrames, ArraysOfManyCompressedBlocksReadBackAndDoNotDependOnTheThreads
   EXPECT_EQ(read_text(dir / "threads.vtu"), read_text(dir / "serial.vtu"));
   const VtkFrame frame = read_vtk_frame(dir / "threads.vtu");
   EXPECT_TRUE((frame.cell_field("stress").array() == stress.array()).all());
+  EXPECT_TRUE((frame.cell_field("green_strain").array() == strain.array()).all());
   EXPECT_TRUE((frame.points.array() == mesh.vertices.array()).all());
 }
 

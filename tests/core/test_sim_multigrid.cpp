@@ -132,24 +132,30 @@ TEST(Multigrid, FinestProductsFollowTheOperatorInUse) {
   B << 2.0, 0.5, 0.0, 0.5, 2.0, 0.5, 0.0, 0.5, 2.0;  // SPD, with stored zeros in every block
   const SparseMatrixd blocked = kron3(random_spd(300, 4, random), B);
   const SparseMatrixd scalar = random_spd(900, 6, random);  // no whole blocks
-  for (const SparseMatrixd* A : {&blocked, &scalar}) {
-    MultigridPreconditioner mg({P});
-    ASSERT_TRUE(mg.setup(*A));
-    const VectorXd x = VectorXd::Random(900);
-    const VectorXd Ax = *A * x;
-    VectorXd y;
-    mg.multiply_finest(*A, x, y);
-    EXPECT_LE((y - Ax).norm(), 1e-13 * Ax.norm());
-    // update_finest: the products follow the new operator.
-    const SparseMatrixd doubled = 2.0 * *A;
-    mg.update_finest(doubled);
-    mg.multiply_finest(doubled, x, y);
-    EXPECT_LE((y - 2.0 * Ax).norm(), 1e-13 * Ax.norm());
-    // A matrix other than the finest operator is multiplied as it is.
-    const SparseMatrixd tripled = 3.0 * *A;
-    mg.multiply_finest(tripled, x, y);
-    EXPECT_LE((y - 3.0 * Ax).norm(), 1e-13 * Ax.norm());
-  }
+  // CG's products stay in double when the cycle's are rounded (single_precision_min_blocks 0).
+  MultigridOptions single;
+  single.single_precision_min_blocks = 0;
+  for (const SparseMatrixd* A : {&blocked, &scalar})
+    for (const MultigridOptions& options : {MultigridOptions(), single}) {
+      MultigridPreconditioner mg({P}, options);
+      ASSERT_TRUE(mg.setup(*A));
+      EXPECT_EQ(mg.single_precision_products(1),
+                A == &blocked && options.single_precision_min_blocks == 0);
+      const VectorXd x = VectorXd::Random(900);
+      const VectorXd Ax = *A * x;
+      VectorXd y;
+      mg.multiply_finest(*A, x, y);
+      EXPECT_LE((y - Ax).norm(), 1e-13 * Ax.norm());
+      // update_finest: the products follow the new operator.
+      const SparseMatrixd doubled = 2.0 * *A;
+      mg.update_finest(doubled);
+      mg.multiply_finest(doubled, x, y);
+      EXPECT_LE((y - 2.0 * Ax).norm(), 1e-13 * Ax.norm());
+      // A matrix other than the finest operator is multiplied as it is.
+      const SparseMatrixd tripled = 3.0 * *A;
+      mg.multiply_finest(tripled, x, y);
+      EXPECT_LE((y - 3.0 * Ax).norm(), 1e-13 * Ax.norm());
+    }
 }
 
 /// Prolongations of three levels, 80 → 400 → 2000 unknowns.

@@ -52,13 +52,13 @@ struct TreeCycle final : SpdSolver::Cycle {
 /// system size; later setups keep them), the Galerkin products, Chebyshev smoothers and coarsest
 /// factorisation are those of the tree's multigrid, on TBB threads.
 struct AlgebraicCycle final : SpdSolver::Cycle {
-  std::vector<Index> free_dofs;  ///< of the systems; empty: every vertex whole
-  MultigridOptions cycle_options;
+  std::vector<Index> free_dofs;           ///< of the systems; empty: every vertex whole
+  const MultigridOptions* cycle_options;  ///< the solver's, read when the cycle is built
   std::unique_ptr<MultigridPreconditioner> cycle;
   Index rows = -1;
   double seconds = 0.0;
 
-  AlgebraicCycle(std::vector<Index> dofs, const MultigridOptions& options)
+  AlgebraicCycle(std::vector<Index> dofs, const MultigridOptions* options)
       : free_dofs(std::move(dofs)), cycle_options(options) {}
   bool setup(const SparseMatrixd& A) override {
     const auto start = std::chrono::steady_clock::now();
@@ -78,7 +78,7 @@ struct AlgebraicCycle final : SpdSolver::Cycle {
       if (ok) prolongations = amg.prolongations();
       ok = ok && !prolongations.empty();  // too small to coarsen
       if (ok) {
-        cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations), cycle_options);
+        cycle = std::make_unique<MultigridPreconditioner>(std::move(prolongations), *cycle_options);
         rows = A.rows();
       }
     }
@@ -151,7 +151,7 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
 
 void SpdSolver::use_algebraic_multigrid() {
   m_kind = LinearSolverKind::amg;
-  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_dofs, m_cycle_options);
+  m_multigrid = std::make_unique<AlgebraicCycle>(m_free_dofs, &m_cycle_options);
   m_multigrid_stale = true;
 }
 

@@ -23,7 +23,10 @@ class BlockSymmetricMatrix {
   /// Whether assign() also keeps the values rounded to single precision (written in the same
   /// pass), for multiply_single(). Takes effect at the next assign().
   void keep_single_precision(bool keep) { m_keep_single = keep; }
-  bool has_single_precision() const { return m_num_blocks > 0 && m_keep_single; }
+  /// Whether the last assign() kept the rounded values.
+  bool has_single_precision() const {
+    return m_num_blocks > 0 && m_single.size() == m_values.size();
+  }
   bool empty() const { return m_num_blocks == 0; }
   Index rows() const { return 3 * m_num_blocks; }
 

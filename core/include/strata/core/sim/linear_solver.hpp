@@ -71,7 +71,8 @@ class SpdSolver {
   double relative_tolerance() const { return m_relative_tolerance; }
   /// Iteration limit of multigrid-PCG (default 500) before it falls back to CHOLMOD.
   void set_max_iterations(int iterations) { m_max_iterations = iterations; }
-  /// The options of the multigrid cycles (tree and algebraic) built after this call.
+  /// The options of the multigrid cycles: the tree's cycle built by a later use_nested_spaces(),
+  /// the algebraic one at its next hierarchy (a new system size).
   void set_multigrid_options(const MultigridOptions& options) { m_cycle_options = options; }
 
   /// The solver in use (never `automatic`).
