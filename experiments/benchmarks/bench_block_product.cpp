@@ -1,6 +1,6 @@
 // The product y = K x of a stiffness matrix stored by 3 × 3 blocks (BlockSymmetricMatrix), with
 // its values in double (CG's products) and rounded to single precision (the multigrid cycle's,
-// MultigridOptions::single_precision_cycle), and the copy from the compressed matrix (assign)
+// MultigridOptions::single_precision_min_blocks), and the copy from the compressed matrix (assign)
 // without and with the rounded values, which a Newton iteration pays. Bytes per second count
 // the values, block rows and x and y as read or written once. Names:
 // block_product/<double|single|assign|assign_single>/tets:<#T>/threads:<n>.

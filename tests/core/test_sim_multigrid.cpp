@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <limits>
 #include <random>
 #include <string>
 #include <utility>
@@ -247,7 +248,7 @@ TEST(Multigrid, ACoarseSpaceOfEverythingMakesTheCycleExact) {
 class ReferenceCycle {
  public:
   /// `rounded`: the smoothers' and residuals' products by the operators' values rounded to
-  /// single precision (MultigridOptions::single_precision_cycle); the Galerkin products, the
+  /// single precision (MultigridOptions::single_precision_min_blocks); the Galerkin products, the
   /// diagonals and the coarsest solve by the operators themselves.
   ReferenceCycle(const SparseMatrixd& A, const std::vector<SparseMatrixd>& P,
                  const MultigridPreconditioner& mg, int degree, bool rounded = false)
@@ -338,8 +339,7 @@ TEST(Multigrid, CycleIsTheTextbookVCycle) {
                      ", degree " + std::to_string(degree));
         MultigridOptions options;
         options.smoothing_degree = degree;
-        options.single_precision_cycle = single;
-        options.single_precision_min_blocks = 0;
+        options.single_precision_min_blocks = single ? 0 : std::numeric_limits<Index>::max();
         MultigridPreconditioner mg(P, options);
         ASSERT_TRUE(mg.setup(A));
         const bool rounded = single && blocked;

@@ -290,9 +290,8 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   // large ones with a single-precision copy for the cycle's products.
   for (int k = 1; k <= L; ++k) {
     const SparseMatrixd& Ak = *m_levels[k]->A;
-    m_levels[k]->blocks.keep_single_precision(m_options.single_precision_cycle &&
-                                              Ak.nonZeros() / 9 >=
-                                                  m_options.single_precision_min_blocks);
+    m_levels[k]->blocks.keep_single_precision(Ak.nonZeros() / 9 >=
+                                              m_options.single_precision_min_blocks);
     m_levels[k]->blocks.assign(Ak);
   }
   if (L == 0) {

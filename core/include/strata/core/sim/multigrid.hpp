@@ -67,14 +67,13 @@ struct MultigridOptions {
   /// Lanczos estimate).
   double chebyshev_lower = 0.05;
   /// The cycle's products (smoothers, residuals, the Lanczos estimate) on each level of at least
-  /// `single_precision_min_blocks` 3 × 3 blocks by a copy of its values rounded to single
-  /// precision, which reads 40 bytes per block instead of 76; vectors and sums stay in double,
-  /// and so do the products of multiply_finest (CG's). The cycle is then the V-cycle of the
-  /// rounded operators (their Galerkin products, diagonals and the coarsest factor come from the
-  /// operators themselves), a symmetric preconditioner as before. Below the size (about 29 MB of
-  /// values, where the products stop running from cache) the rounded copy costs more than it
-  /// saves (`strata_benchmarks --benchmark_filter=block_product`).
-  bool single_precision_cycle = true;
+  /// this many 3 × 3 blocks use a copy of its values rounded to single precision, which reads 40
+  /// bytes per block instead of 76; vectors and sums stay in double, and so do the products of
+  /// multiply_finest (CG's). The smoothers and residuals then use the rounded operators, the
+  /// Galerkin products, diagonals and coarsest factor the operators themselves: a symmetric
+  /// preconditioner as before. On smaller levels the rounded copy measured slower than the
+  /// double one (`strata_benchmarks --benchmark_filter=block_product`). 0: every blocked level;
+  /// std::numeric_limits<Index>::max(): none.
   Index single_precision_min_blocks = 400000;
 };
 
@@ -125,7 +124,7 @@ class MultigridPreconditioner {
   /// products use the 3 × 3-block copy, as of the last setup (for tests and diagnostics).
   std::pair<double, double> smoother_interval(int k) const;
   bool blocked_products(int k) const;
-  /// Whether level k's cycle products use single-precision values (single_precision_cycle).
+  /// Whether level k's cycle products use single-precision values (single_precision_min_blocks).
   bool single_precision_products(int k) const;
   /// Unknowns per level, coarsest first.
   std::vector<Index> level_sizes() const;
