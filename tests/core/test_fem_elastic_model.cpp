@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 
 #include "fem_test_utils.hpp"
+#include "strata/core/common/error.hpp"
 #include "strata/core/common/parallel.hpp"
 #include "strata/core/fem/elastic_model.hpp"
 #include "strata/core/fem/lumped_mass.hpp"
@@ -274,6 +275,35 @@ TEST(ElasticModel, MinVolumeRatioFindsTheInvertedTet) {
   for (int k = 0; k < 4; ++k)
     contains_centre |= mesh.tets(tet, k) == 13;
   EXPECT_TRUE(contains_centre);
+}
+
+/// The message of the InputError that building a model of `mesh` throws ("" if none).
+std::string construction_error(const TetMesh& mesh) {
+  try {
+    const ElasticModel model(mesh.vertices, mesh.tets, test_material(MaterialModel::stvk));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ElasticModel, BadTetsAreReportedByIndexWhateverTheThreadCount) {
+  // The rest data and the tet partition are built side by side; the partition must not read
+  // through an index out of range, and the rest data names the first bad tet.
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {6, 6, 6});
+  ASSERT_EQ(construction_error(mesh), "");
+  TetMesh out_of_range = mesh;
+  out_of_range.tets(700, 2) = static_cast<int>(mesh.vertices.rows()) + 5;
+  out_of_range.tets(900, 1) = -3;
+  TetMesh inverted = mesh;
+  std::swap(inverted.tets(400, 1), inverted.tets(400, 2));
+  for (const int threads : {1, 2}) {
+    const ThreadLimit limit(threads);
+    EXPECT_EQ(
+        construction_error(out_of_range),
+        "tet 700: vertex index " + std::to_string(mesh.vertices.rows() + 5) + " out of range");
+    EXPECT_EQ(construction_error(inverted), "tet 400 is inverted at rest");
+  }
 }
 
 TEST(ElasticModel, ForcesAndMinVolumeRatioInOnePass) {

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/collaborative_call_once.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -67,11 +68,14 @@ ElasticModel::ElasticModel(ConstRef<MatrixX3d> rest_positions, ConstRef<MatrixX4
       m_tets(tets),
       m_material(material),
       m_lame(material.lame()),
-      m_rest(compute_tet_rest_data(rest_positions, tets)),
       m_rest_positions(flatten(rest_positions)),
       m_pattern_once(std::make_unique<PatternOnce>()) {
   validate_material(material, "material");
-  m_partition = build_tet_partition(rest_positions, tets);
+  // Independent, side by side: the partition's sort and colouring are serial passes, which the
+  // rest data's parallel loop fills in around. A bad tet is reported by the rest data (the
+  // partition skips indices out of range).
+  tbb::parallel_invoke([&] { m_rest = compute_tet_rest_data(rest_positions, tets); },
+                       [&] { m_partition = build_tet_partition(rest_positions, tets); });
   const Index num_tets = tets.rows();
   m_sorted_tets.resize(4 * num_tets);
   tbb::parallel_for(Index(0), num_tets, [&](Index i) {

@@ -65,8 +65,10 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
   std::vector<std::pair<std::uint64_t, int>> keyed(num_tets);
   tbb::parallel_for(Index(0), num_tets, [&](Index t) {
     Vector3d centroid = Vector3d::Zero();
-    for (int k = 0; k < 4; ++k)
-      centroid += positions.row(tets(t, k)).transpose();
+    for (int k = 0; k < 4; ++k) {
+      const int v = tets(t, k);
+      if (v >= 0 && v < positions.rows()) centroid += positions.row(v).transpose();
+    }
     const Vector3d unit = ((0.25 * centroid - lower).array() / extent.array()).matrix();
     std::uint64_t key = 0;
     for (int axis = 0; axis < 3; ++axis) {
@@ -103,7 +105,7 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
     for (int i = partition.chunk_begin[c]; i < partition.chunk_begin[c + 1]; ++i)
       for (int k = 0; k < 4; ++k) {
         const int v = tets(partition.order[i], k);
-        if (stamp[v] == c) continue;
+        if (v < 0 || v >= num_vertices || stamp[v] == c) continue;
         stamp[v] = static_cast<int>(c);
         vertices.push_back(v);
       }

@@ -25,7 +25,7 @@ struct TetPartition {
 };
 
 /// Builds the schedule. `target_chunks` bounds the number of chunks (more chunks: better balance,
-/// more colours).
+/// more colours). Vertex indices out of range are skipped (the mesh's validation reports them).
 TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
                                  int target_chunks = 256);
 
