@@ -2,6 +2,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
@@ -368,140 +369,151 @@ void EmbeddedElasticModel::build_reduced_pattern() {
           for (const int v : neighbours[w.row()])
             out.insert(out.end(), row_inner + row_outer[v], row_inner + row_outer[v + 1]);
       });
-  {
-    SparseMatrixd pattern = block_pattern(blocks, "embedding: reduced stiffness matrix");
-    m_pattern.swap(pattern);  // Eigen's assignment from a named matrix would copy it
-  }
   if (9 * layer.indices.size() > std::size_t(std::numeric_limits<int>::max()))
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
 
-  // Element block offsets, vertex by vertex: for each tet of w (local corner b), the blocks (a, b)
-  // of its corners a in K_q's values (a direct tet: w's DOF vertex's list) or in the layer's (w's
-  // layer list). The threads write disjoint entries (one corner of a tet each).
-  m_offsets.resize(48 * num_tets);
-  tbb::enumerable_thread_specific<std::vector<int>> layer_slots(
-      [&] { return std::vector<int>(num_mesh_vertices, -1); });
-  tbb::enumerable_thread_specific<std::vector<int>> dof_slots(
-      [&] { return std::vector<int>(m_num_dof_vertices, -1); });
-  tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
-    std::vector<int>& layer_slot = layer_slots.local();
-    std::vector<int>& dof_slot = dof_slots.local();
-    const std::span<const int> layer_list = layer[w];
-    for (std::size_t k = 0; k < layer_list.size(); ++k)
-      layer_slot[layer_list[k]] = static_cast<int>(k);
-    const int b_dof = direct_dof[w];
-    const std::span<const int> dof_list = b_dof >= 0 ? blocks[b_dof] : std::span<const int>();
-    for (std::size_t k = 0; k < dof_list.size(); ++k)
-      dof_slot[dof_list[k]] = static_cast<int>(k);
-    const Index layer_start = block_column_start(layer, w, 0);
-    const Index layer_column = 3 * layer.list_size(w);
-    const Index dof_start = b_dof >= 0 ? block_column_start(blocks, b_dof, 0) : 0;
-    const Index dof_column = b_dof >= 0 ? 3 * blocks.list_size(b_dof) : 0;
-    int* all_offsets = m_offsets.data();
-    for (const int t : incident[w]) {
-      const int corners[4] = {sorted_tets[4 * t], sorted_tets[4 * t + 1], sorted_tets[4 * t + 2],
-                              sorted_tets[4 * t + 3]};
-      const int b =
-          static_cast<int>(std::find(corners, corners + 4, static_cast<int>(w)) - corners);
-      const bool in_layer = m_in_layer[t];
-      const Index start = in_layer ? layer_start : dof_start;
-      const Index column_length = in_layer ? layer_column : dof_column;
-      int slots[4];
-      for (int a = 0; a < 4; ++a)
-        slots[a] = in_layer ? layer_slot[corners[a]] : dof_slot[direct_dof[corners[a]]];
-      int* offsets = all_offsets + 48 * Index(t);
-      for (int a = 0; a < 4; ++a)
-        for (int c = 0; c < 3; ++c)
-          offsets[12 * a + 3 * b + c] = static_cast<int>(start + 3 * slots[a] + c * column_length);
-    }
-    for (const int v : layer_list)
-      layer_slot[v] = -1;
-    for (const int q : dof_list)
-      dof_slot[q] = -1;
-  });
+  // The scalar pattern of K_q and the assembly plan (element offsets, the layer's targets) need
+  // only the block lists: they are built side by side.
+  SparseMatrixd pattern;
+  FillVector<int> block_targets;
+  FillVector<WeightedTarget> weighted_targets;
+  const auto plan = [&] {
+    // Element block offsets, vertex by vertex: for each tet of w (local corner b), the blocks (a,
+    // b) of its corners a in K_q's values (a direct tet: w's DOF vertex's list) or in the layer's
+    // (w's layer list). The threads write disjoint entries (one corner of a tet each).
+    m_offsets.resize(48 * num_tets);
+    tbb::enumerable_thread_specific<std::vector<int>> layer_slots(
+        [&] { return std::vector<int>(num_mesh_vertices, -1); });
+    tbb::enumerable_thread_specific<std::vector<int>> dof_slots(
+        [&] { return std::vector<int>(m_num_dof_vertices, -1); });
+    tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+      std::vector<int>& layer_slot = layer_slots.local();
+      std::vector<int>& dof_slot = dof_slots.local();
+      const std::span<const int> layer_list = layer[w];
+      for (std::size_t k = 0; k < layer_list.size(); ++k)
+        layer_slot[layer_list[k]] = static_cast<int>(k);
+      const int b_dof = direct_dof[w];
+      const std::span<const int> dof_list = b_dof >= 0 ? blocks[b_dof] : std::span<const int>();
+      for (std::size_t k = 0; k < dof_list.size(); ++k)
+        dof_slot[dof_list[k]] = static_cast<int>(k);
+      const Index layer_start = block_column_start(layer, w, 0);
+      const Index layer_column = 3 * layer.list_size(w);
+      const Index dof_start = b_dof >= 0 ? block_column_start(blocks, b_dof, 0) : 0;
+      const Index dof_column = b_dof >= 0 ? 3 * blocks.list_size(b_dof) : 0;
+      int* all_offsets = m_offsets.data();
+      for (const int t : incident[w]) {
+        const int corners[4] = {sorted_tets[4 * t], sorted_tets[4 * t + 1], sorted_tets[4 * t + 2],
+                                sorted_tets[4 * t + 3]};
+        const int b =
+            static_cast<int>(std::find(corners, corners + 4, static_cast<int>(w)) - corners);
+        const bool in_layer = m_in_layer[t];
+        const Index start = in_layer ? layer_start : dof_start;
+        const Index column_length = in_layer ? layer_column : dof_column;
+        int slots[4];
+        for (int a = 0; a < 4; ++a)
+          slots[a] = in_layer ? layer_slot[corners[a]] : dof_slot[direct_dof[corners[a]]];
+        int* offsets = all_offsets + 48 * Index(t);
+        for (int a = 0; a < 4; ++a)
+          for (int c = 0; c < 3; ++c)
+            offsets[12 * a + 3 * b + c] =
+                static_cast<int>(start + 3 * slots[a] + c * column_length);
+      }
+      for (const int v : layer_list)
+        layer_slot[v] = -1;
+      for (const int q : dof_list)
+        dof_slot[q] = -1;
+    });
 
-  // The targets of the layer's blocks, in the order of its values: the columns (w, j), their
-  // blocks v, then the entries C_va, C_wb. A block of two direct vertices adds to one reduced
-  // block directly.
-  std::vector<Index> first_weighted(num_mesh_vertices + 1, 0);
-  tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
-    const Index w_entries = row_outer[w + 1] - row_outer[w];
-    Index count = 0;
-    for (const int v : layer[w])
-      if (direct_dof[v] < 0 || direct_dof[w] < 0)
-        count += (row_outer[v + 1] - row_outer[v]) * w_entries;
-    first_weighted[w + 1] = 3 * count;
-  });
-  for (Index w = 0; w < num_mesh_vertices; ++w)
-    first_weighted[w + 1] += first_weighted[w];
-  if (first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
-    throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
-  FillVector<int> block_targets(3 * layer.indices.size());
-  FillVector<WeightedTarget> weighted_targets(first_weighted[num_mesh_vertices]);
-  // Per thread: the slot of each DOF vertex in the lists of `blocks` of w's row entries (up to
-  // kMarked of them; −1 elsewhere), and the slots of one vertex's targets.
-  constexpr int kMarked = 4;
-  tbb::enumerable_thread_specific<std::vector<int>> slots_of(
-      [&] { return std::vector<int>(m_num_dof_vertices, -1); });
-  tbb::enumerable_thread_specific<std::vector<Index>> target_slots;
-  tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
-    const std::span<const int> list = layer[w];
-    if (list.empty()) return;
-    // The DOF vertices b of w's row (one unless w hangs) and the slots in their lists.
-    const int first_b = row_outer[w];
-    const int num_b = row_outer[w + 1] - first_b;
-    const bool marked = num_b <= kMarked;
-    std::vector<int>& marks_of = slots_of.local();  // more arrays only once a vertex hangs
-    if (marked && marks_of.size() < num_b * std::size_t(m_num_dof_vertices))
-      marks_of.resize(num_b * std::size_t(m_num_dof_vertices), -1);
-    int* slot_of = marks_of.data();
-    if (marked)
-      for (int k = 0; k < num_b; ++k) {
-        const std::span<const int> b_list = blocks[row_inner[first_b + k]];
-        int* marks = slot_of + k * m_num_dof_vertices;
-        for (std::size_t i = 0; i < b_list.size(); ++i)
-          marks[b_list[i]] = static_cast<int>(i);
-      }
-    auto slot = [&](int a, int ib) -> Index {
-      if (marked) return slot_of[(ib - first_b) * m_num_dof_vertices + a];
-      const std::span<const int> b_list = blocks[row_inner[ib]];
-      return std::lower_bound(b_list.begin(), b_list.end(), a) - b_list.begin();
-    };
-    // The slots of the targets of every block (v, w), in the order (v, C_va, C_wb).
-    std::vector<Index>& slots = target_slots.local();
-    slots.clear();
-    for (const int v : list)
-      for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
-        for (int ib = first_b; ib < first_b + num_b; ++ib)
-          slots.push_back(slot(row_inner[ia], ib));
-    if (marked)
-      for (int k = 0; k < num_b; ++k) {
-        int* marks = slot_of + k * m_num_dof_vertices;
-        for (const int a : blocks[row_inner[first_b + k]])
-          marks[a] = -1;
-      }
-    // The layer's values are column by column (3w + j), each holding the blocks of `list`.
-    Index position = first_weighted[w];
-    for (int j = 0; j < 3; ++j) {
-      const Index* next_slot = slots.data();
-      for (std::size_t k = 0; k < list.size(); ++k) {
-        const int v = list[k];
-        const Index block = block_column_start(layer, w, j) / 3 + static_cast<Index>(k);
-        if (direct_dof[v] >= 0 && direct_dof[w] >= 0) {
-          block_targets[block] =
-              static_cast<int>(block_column_start(blocks, direct_dof[w], j) + 3 * *next_slot++);
-          continue;
+    // The targets of the layer's blocks, in the order of its values: the columns (w, j), their
+    // blocks v, then the entries C_va, C_wb. A block of two direct vertices adds to one reduced
+    // block directly.
+    std::vector<Index> first_weighted(num_mesh_vertices + 1, 0);
+    tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+      const Index w_entries = row_outer[w + 1] - row_outer[w];
+      Index count = 0;
+      for (const int v : layer[w])
+        if (direct_dof[v] < 0 || direct_dof[w] < 0)
+          count += (row_outer[v + 1] - row_outer[v]) * w_entries;
+      first_weighted[w + 1] = 3 * count;
+    });
+    for (Index w = 0; w < num_mesh_vertices; ++w)
+      first_weighted[w + 1] += first_weighted[w];
+    if (first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
+      throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
+    block_targets.resize(3 * layer.indices.size());
+    weighted_targets.resize(first_weighted[num_mesh_vertices]);
+    // Per thread: the slot of each DOF vertex in the lists of `blocks` of w's row entries (up to
+    // kMarked of them; −1 elsewhere), and the slots of one vertex's targets.
+    constexpr int kMarked = 4;
+    tbb::enumerable_thread_specific<std::vector<int>> slots_of(
+        [&] { return std::vector<int>(m_num_dof_vertices, -1); });
+    tbb::enumerable_thread_specific<std::vector<Index>> target_slots;
+    tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
+      const std::span<const int> list = layer[w];
+      if (list.empty()) return;
+      // The DOF vertices b of w's row (one unless w hangs) and the slots in their lists.
+      const int first_b = row_outer[w];
+      const int num_b = row_outer[w + 1] - first_b;
+      const bool marked = num_b <= kMarked;
+      std::vector<int>& marks_of = slots_of.local();  // more arrays only once a vertex hangs
+      if (marked && marks_of.size() < num_b * std::size_t(m_num_dof_vertices))
+        marks_of.resize(num_b * std::size_t(m_num_dof_vertices), -1);
+      int* slot_of = marks_of.data();
+      if (marked)
+        for (int k = 0; k < num_b; ++k) {
+          const std::span<const int> b_list = blocks[row_inner[first_b + k]];
+          int* marks = slot_of + k * m_num_dof_vertices;
+          for (std::size_t i = 0; i < b_list.size(); ++i)
+            marks[b_list[i]] = static_cast<int>(i);
         }
-        const Index first = position;
+      auto slot = [&](int a, int ib) -> Index {
+        if (marked) return slot_of[(ib - first_b) * m_num_dof_vertices + a];
+        const std::span<const int> b_list = blocks[row_inner[ib]];
+        return std::lower_bound(b_list.begin(), b_list.end(), a) - b_list.begin();
+      };
+      // The slots of the targets of every block (v, w), in the order (v, C_va, C_wb).
+      std::vector<Index>& slots = target_slots.local();
+      slots.clear();
+      for (const int v : list)
         for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
-          for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
-            weighted_targets[position++] = {
-                static_cast<int>(block_column_start(blocks, row_inner[ib], j) + 3 * *next_slot++),
-                row_values[ia] * row_values[ib]};
-        block_targets[block] = ~static_cast<int>(position - first);
+          for (int ib = first_b; ib < first_b + num_b; ++ib)
+            slots.push_back(slot(row_inner[ia], ib));
+      if (marked)
+        for (int k = 0; k < num_b; ++k) {
+          int* marks = slot_of + k * m_num_dof_vertices;
+          for (const int a : blocks[row_inner[first_b + k]])
+            marks[a] = -1;
+        }
+      // The layer's values are column by column (3w + j), each holding the blocks of `list`.
+      Index position = first_weighted[w];
+      for (int j = 0; j < 3; ++j) {
+        const Index* next_slot = slots.data();
+        for (std::size_t k = 0; k < list.size(); ++k) {
+          const int v = list[k];
+          const Index block = block_column_start(layer, w, j) / 3 + static_cast<Index>(k);
+          if (direct_dof[v] >= 0 && direct_dof[w] >= 0) {
+            block_targets[block] =
+                static_cast<int>(block_column_start(blocks, direct_dof[w], j) + 3 * *next_slot++);
+            continue;
+          }
+          const Index first = position;
+          for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
+            for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
+              weighted_targets[position++] = {
+                  static_cast<int>(block_column_start(blocks, row_inner[ib], j) + 3 * *next_slot++),
+                  row_values[ia] * row_values[ib]};
+          block_targets[block] = ~static_cast<int>(position - first);
+        }
       }
-    }
-  });
+    });
+  };
+  tbb::parallel_invoke(
+      [&] {
+        SparseMatrixd built = block_pattern(blocks, "embedding: reduced stiffness matrix");
+        pattern.swap(built);  // Eigen's assignment from a named matrix would copy it
+      },
+      plan);
+  m_pattern.swap(pattern);
   group_layer_additions(block_targets, weighted_targets);
 }
 
