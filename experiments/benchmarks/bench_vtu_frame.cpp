@@ -2,7 +2,9 @@
 // and velocity per vertex, Green strain, Cauchy stress, von Mises stress and level per tet.
 // Throughput in tets/s and the raw array bytes per second (bytes_per_second) for each mesh size
 // and thread count, and the file's size over the raw arrays' (file_over_raw); the fields are
-// computed once, outside the timed loop. Names: vtu_frame/tets:<#T>/threads:<n>.
+// computed once, outside the timed loop. Names: vtu_frame/tets:<#T>/threads:<n>, and
+// vtu_frame_series/… for the frames of a series between two cut changes, whose integer arrays
+// (connectivity, offsets, types, level) come from the series' VtuArrayCache.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -17,7 +19,7 @@
 namespace strata::bench {
 namespace {
 
-void vtu_frame_benchmark(benchmark::State& state, MeshSize size, int threads) {
+void vtu_frame_benchmark(benchmark::State& state, MeshSize size, int threads, bool series) {
   const ThreadLimit limit(threads);
   const ModelCase& c = model_case(size, MaterialModel::neohookean);
   const MatrixX3d positions = unflatten(c.deformed);
@@ -31,8 +33,10 @@ void vtu_frame_benchmark(benchmark::State& state, MeshSize size, int threads) {
   fields.add_cell_data("level", Eigen::MatrixXi(Eigen::MatrixXi::Zero(c.mesh.tets.rows(), 1)));
   const std::filesystem::path path = std::filesystem::temp_directory_path() /
                                      ("strata_bench_frame_" + std::to_string(getpid()) + ".vtu");
+  VtuArrayCache cache;
+  if (series) write_vtu(path, positions, c.mesh.tets, fields, VtkEncoding::binary, &cache);
   for (auto _ : state)
-    write_vtu(path, positions, c.mesh.tets, fields, VtkEncoding::binary);
+    write_vtu(path, positions, c.mesh.tets, fields, VtkEncoding::binary, series ? &cache : nullptr);
   const double file_bytes = static_cast<double>(std::filesystem::file_size(path));
   std::filesystem::remove(path);
   const Index nv = c.mesh.vertices.rows(), nt = c.mesh.tets.rows();
@@ -49,10 +53,12 @@ void vtu_frame_benchmark(benchmark::State& state, MeshSize size, int threads) {
 const bool registered = [] {
   for (const MeshSize& size : mesh_sizes())
     for (int threads : thread_counts())
-      benchmark::RegisterBenchmark(benchmark_name("vtu_frame", size, threads).c_str(),
-                                   vtu_frame_benchmark, size, threads)
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime();
+      for (const bool series : {false, true})
+        benchmark::RegisterBenchmark(
+            benchmark_name(series ? "vtu_frame_series" : "vtu_frame", size, threads).c_str(),
+            vtu_frame_benchmark, size, threads, series)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
   return true;
 }();
 

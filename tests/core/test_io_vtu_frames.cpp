@@ -166,6 +166,49 @@ TEST(IoVtuFrames, ArraysThatDoNotDeflateAreStoredAndReadBackExactly) {
   EXPECT_TRUE((frame.cell_field("green_strain").array() == strain.array()).all());
 }
 
+TEST(IoVtuFrames, ACacheReusesRepeatedIntegerArraysAndWritesTheSameBytes) {
+  // Frames of a series: the cache must give the bytes written without it, reuse an integer array
+  // only when its bytes repeat, and never hold a float array.
+  ScratchDir dir("io_frame_cache");
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {12, 12, 12});  // 10k tets
+  TetMesh permuted = mesh;  // the same tets in another order: same offsets and types
+  permuted.tets.topRows(100).swap(permuted.tets.bottomRows(100));
+  const TetMesh smaller = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {12, 12, 11});
+  struct Frame {
+    const TetMesh* mesh;
+    double scale;
+    int level;
+  };
+  // Positions change every frame; the mesh and the levels only at frames 2, 3 and 4.
+  const std::vector<Frame> frames = {{&mesh, 0.1, 0},
+                                     {&mesh, 0.2, 0},
+                                     {&permuted, 0.3, 0},
+                                     {&permuted, 0.4, 1},
+                                     {&smaller, 0.5, 1}};
+  // Arrays compressed (not taken from the cache) at each frame: connectivity, offsets, types,
+  // level.
+  const std::vector<std::size_t> compressed_after = {4, 4, 5, 6, 10};
+  VtuArrayCache cache;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    const TetMesh& m = *frames[f].mesh;
+    MatrixX3d displacement = MatrixX3d::Zero(m.vertices.rows(), 3);
+    displacement.col(2) = frames[f].scale * m.vertices.col(0).array().square().matrix();
+    VtuFields fields;
+    fields.add_point_data("displacement", displacement);
+    fields.add_cell_data("stress", Eigen::MatrixXd::Constant(m.tets.rows(), 6, frames[f].scale));
+    fields.add_cell_data("level", Eigen::MatrixXi::Constant(m.tets.rows(), 1, frames[f].level));
+    const MatrixX3d positions = m.vertices + displacement;
+    write_vtu(dir / "plain.vtu", positions, m.tets, fields);
+    write_vtu(dir / "cached.vtu", positions, m.tets, fields, VtkEncoding::binary, &cache);
+    EXPECT_EQ(read_text(dir / "cached.vtu"), read_text(dir / "plain.vtu")) << "frame " << f;
+    EXPECT_EQ(cache.compressed(), compressed_after[f]) << "frame " << f;
+    EXPECT_EQ(cache.reused() + cache.compressed(), 4 * (f + 1)) << "frame " << f;
+  }
+  // ASCII frames do not use it.
+  write_vtu(dir / "a.vtu", mesh.vertices, mesh.tets, {}, VtkEncoding::ascii, &cache);
+  EXPECT_EQ(cache.reused() + cache.compressed(), 4 * frames.size());
+}
+
 TEST(IoVtuFrames, FieldWithWrongRowCountIsInputErrorNamingIt) {
   ScratchDir dir("io_frame_rows");
   const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d::Ones(), {1, 1, 1});

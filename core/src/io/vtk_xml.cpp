@@ -106,7 +106,8 @@ void DataArrayWriter::begin_file(std::ostream& out, const char* type) const {
       << ">\n";
 }
 
-void DataArrayWriter::append_compressed(const std::uint8_t* data, std::size_t size) {
+void DataArrayWriter::append_compressed(const std::uint8_t* data, std::size_t size,
+                                        std::vector<std::uint8_t>& into) {
   const std::size_t num_blocks = (size + kBlockSize - 1) / kBlockSize;
   std::vector<std::vector<std::uint8_t>> compressed(num_blocks);
   std::atomic<bool> failed{false};
@@ -139,15 +140,15 @@ void DataArrayWriter::append_compressed(const std::uint8_t* data, std::size_t si
   std::size_t total = 8 * (3 + num_blocks);
   for (const std::vector<std::uint8_t>& block : compressed)
     total += block.size();
-  const std::size_t header_at = m_appended.size();
-  m_appended.resize(header_at + total);
-  put_u64(m_appended, header_at, num_blocks);
-  put_u64(m_appended, header_at + 8, kBlockSize);
-  put_u64(m_appended, header_at + 16, size % kBlockSize);  // 0: the last block is full
+  const std::size_t header_at = into.size();
+  into.resize(header_at + total);
+  put_u64(into, header_at, num_blocks);
+  put_u64(into, header_at + 8, kBlockSize);
+  put_u64(into, header_at + 16, size % kBlockSize);  // 0: the last block is full
   std::size_t at = header_at + 8 * (3 + num_blocks);
   for (std::size_t b = 0; b < num_blocks; ++b) {
-    put_u64(m_appended, header_at + 8 * (3 + b), compressed[b].size());
-    std::memcpy(m_appended.data() + at, compressed[b].data(), compressed[b].size());
+    put_u64(into, header_at + 8 * (3 + b), compressed[b].size());
+    std::memcpy(into.data() + at, compressed[b].data(), compressed[b].size());
     at += compressed[b].size();
   }
 }
@@ -160,8 +161,21 @@ void DataArrayWriter::write(std::ostream& out, const std::string& name, int comp
   out << " NumberOfComponents=\"" << components << "\"";
   if (m_encoding == VtkEncoding::binary) {
     out << " format=\"appended\" offset=\"" << m_appended.size() << "\"/>\n";
-    append_compressed(reinterpret_cast<const std::uint8_t*>(values.data()),
-                      values.size() * sizeof(T));
+    const auto* raw = reinterpret_cast<const std::uint8_t*>(values.data());
+    const std::size_t size = values.size() * sizeof(T);
+    if (!std::is_integral_v<T> || m_cache == nullptr) {
+      append_compressed(raw, size, m_appended);
+      return;
+    }
+    const std::string key = name + "/" + type_name<T>() + "/" + std::to_string(components);
+    if (const std::vector<std::uint8_t>* kept = m_cache->find(key, raw, size)) {
+      m_appended.insert(m_appended.end(), kept->begin(), kept->end());
+      return;
+    }
+    std::vector<std::uint8_t> made;
+    append_compressed(raw, size, made);
+    m_appended.insert(m_appended.end(), made.begin(), made.end());
+    m_cache->keep(key, raw, size, std::move(made));
     return;
   }
   out << " format=\"ascii\">\n";
@@ -220,3 +234,25 @@ void DataArrayWriter::end_file(std::ostream& out) const {
 }
 
 }  // namespace strata::vtk_xml
+
+namespace strata {
+
+const std::vector<std::uint8_t>* VtuArrayCache::find(const std::string& name,
+                                                     const std::uint8_t* raw, std::size_t size) {
+  const auto found = m_entries.find(name);
+  if (found == m_entries.end() || found->second.raw.size() != size ||
+      (size > 0 && std::memcmp(found->second.raw.data(), raw, size) != 0))
+    return nullptr;
+  ++m_reused;
+  return &found->second.compressed;
+}
+
+void VtuArrayCache::keep(const std::string& name, const std::uint8_t* raw, std::size_t size,
+                         std::vector<std::uint8_t> compressed) {
+  Entry& entry = m_entries[name];
+  entry.raw.assign(raw, raw + size);
+  entry.compressed = std::move(compressed);
+  ++m_compressed;
+}
+
+}  // namespace strata

@@ -25,7 +25,9 @@ void check_field_rows(const std::filesystem::path& path, const VtuFields& fields
 /// behind a UInt64 header (VTK's vtkZLibDataCompressor layout).
 class DataArrayWriter {
  public:
-  explicit DataArrayWriter(VtkEncoding encoding) : m_encoding(encoding) {}
+  /// With a `cache`, binary integer arrays go through it (VtuArrayCache).
+  explicit DataArrayWriter(VtkEncoding encoding, VtuArrayCache* cache = nullptr)
+      : m_encoding(encoding), m_cache(cache) {}
 
   /// `<?xml …?>` and the `<VTKFile type="…">` start tag (with the compressor when binary).
   void begin_file(std::ostream& out, const char* type) const;
@@ -45,9 +47,12 @@ class DataArrayWriter {
   void end_file(std::ostream& out) const;
 
  private:
-  void append_compressed(const std::uint8_t* data, std::size_t size);
+  /// Appends the zlib blocks of `data[0, size)` behind their UInt64 header to `into`.
+  static void append_compressed(const std::uint8_t* data, std::size_t size,
+                                std::vector<std::uint8_t>& into);
 
   VtkEncoding m_encoding;
+  VtuArrayCache* m_cache;
   std::vector<std::uint8_t> m_appended;
 };
 

@@ -16,7 +16,7 @@ namespace {
 /// section, "Polys" or "Lines".
 void write_polydata(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
                     const std::vector<int>& connectivity, int nodes, const char* section,
-                    const VtuFields& fields, VtkEncoding encoding) {
+                    const VtuFields& fields, VtkEncoding encoding, VtuArrayCache* cache) {
   const Index num_points = positions.rows();
   const auto num_cells = static_cast<Index>(connectivity.size()) / nodes;
   vtk_xml::check_field_rows(path, fields, num_points, num_cells);
@@ -31,7 +31,7 @@ void write_polydata(const std::filesystem::path& path, ConstRef<MatrixX3d> posit
   for (Index c = 0; c < num_cells; ++c)
     offsets[c] = nodes * (c + 1);
   write_file_atomically(path, [&](std::ostream& out) {
-    vtk_xml::DataArrayWriter arrays(encoding);
+    vtk_xml::DataArrayWriter arrays(encoding, cache);
     arrays.begin_file(out, "PolyData");
     out << "  <PolyData>\n"
         << "    <Piece NumberOfPoints=\"" << num_points << "\" NumberOfVerts=\"0\" NumberOfLines=\""
@@ -49,13 +49,14 @@ void write_polydata(const std::filesystem::path& path, ConstRef<MatrixX3d> posit
 }  // namespace
 
 void write_vtp(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
-               ConstRef<MatrixX3i> triangles, const VtuFields& fields, VtkEncoding encoding) {
+               ConstRef<MatrixX3i> triangles, const VtuFields& fields, VtkEncoding encoding,
+               VtuArrayCache* cache) {
   std::vector<int> connectivity;
   connectivity.reserve(3 * triangles.rows());
   for (Index f = 0; f < triangles.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       connectivity.push_back(triangles(f, k));
-  write_polydata(path, positions, connectivity, 3, "Polys", fields, encoding);
+  write_polydata(path, positions, connectivity, 3, "Polys", fields, encoding, cache);
 }
 
 void write_vtp_lines(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
@@ -67,7 +68,7 @@ void write_vtp_lines(const std::filesystem::path& path, ConstRef<MatrixX3d> posi
     connectivity.push_back(a);
     connectivity.push_back(b);
   }
-  write_polydata(path, positions, connectivity, 2, "Lines", fields, encoding);
+  write_polydata(path, positions, connectivity, 2, "Lines", fields, encoding, nullptr);
 }
 
 }  // namespace strata

@@ -16,7 +16,8 @@ constexpr int kVtkTetra = 10;  ///< VTK cell type of a linear tetrahedron
 }  // namespace
 
 void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
-               ConstRef<MatrixX4i> tets, const VtuFields& fields, VtkEncoding encoding) {
+               ConstRef<MatrixX4i> tets, const VtuFields& fields, VtkEncoding encoding,
+               VtuArrayCache* cache) {
   const Index num_points = positions.rows();
   const Index num_cells = tets.rows();
   vtk_xml::check_field_rows(path, fields, num_points, num_cells);
@@ -31,7 +32,7 @@ void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
   const std::vector<std::uint8_t> types(static_cast<std::size_t>(num_cells), kVtkTetra);
 
   write_file_atomically(path, [&](std::ostream& out) {
-    vtk_xml::DataArrayWriter arrays(encoding);
+    vtk_xml::DataArrayWriter arrays(encoding, cache);
     arrays.begin_file(out, "UnstructuredGrid");
     out << "  <UnstructuredGrid>\n"
         << "    <Piece NumberOfPoints=\"" << num_points << "\" NumberOfCells=\"" << num_cells

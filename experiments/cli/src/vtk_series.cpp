@@ -71,7 +71,7 @@ void VtkSeries::write_frame(double time, const Simulation& simulation, const Vec
   char name[32];
   std::snprintf(name, sizeof name, "_%06d.vtu", m_frames);
   const std::string file = m_stem + name;
-  write_vtu(m_folder / file, positions, mesh.tets, fields, m_encoding);
+  write_vtu(m_folder / file, positions, mesh.tets, fields, m_encoding, &m_mesh_arrays);
   m_pvd.add_frame(time, file);
   ++m_frames;
 }
@@ -81,7 +81,7 @@ void VtkSeries::write_surface_frame(double time, ConstRef<MatrixX3d> positions,
   char name[40];
   std::snprintf(name, sizeof name, "_surface_%06d.vtp", std::max(m_frames - 1, 0));
   const std::string file = m_stem + name;
-  write_vtp(m_folder / file, positions, triangles, fields, m_encoding);
+  write_vtp(m_folder / file, positions, triangles, fields, m_encoding, &m_surface_arrays);
   m_pvd.add_frame(time, file, 1);
 }
 

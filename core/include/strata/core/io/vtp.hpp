@@ -14,10 +14,11 @@ namespace strata {
 /// Writes a triangle surface as a .vtp in `encoding`, atomically: `positions` (#V × 3), `triangles`
 /// (#F × 3, written as Polys) and the named `fields` (point data #V × k, cell data #F × k;
 /// Float64 / Int32). Throws InputError naming the path and field when a field's row count does not
-/// match #V or #F, or a triangle index is out of range.
+/// match #V or #F, or a triangle index is out of range. With a `cache` (binary only), the integer
+/// arrays that repeat the previous frame's are not compressed again (VtuArrayCache).
 void write_vtp(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
                ConstRef<MatrixX3i> triangles, const VtuFields& fields = {},
-               VtkEncoding encoding = VtkEncoding::binary);
+               VtkEncoding encoding = VtkEncoding::binary, VtuArrayCache* cache = nullptr);
 
 /// Writes line segments (`segments` #L pairs of point indices, written as Lines) as a .vtp in
 /// `encoding`, atomically, with point fields (#V × k) and cell fields (#L × k), e.g. a curve

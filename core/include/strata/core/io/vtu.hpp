@@ -2,9 +2,12 @@
 /// \file vtu.hpp
 /// VTK XML unstructured grids (.vtu): tet meshes and simulation frames for ParaView.
 /// Format: https://docs.vtk.org/en/latest/design_documents/VTKFileFormats.html
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <type_traits>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -48,13 +51,41 @@ struct VtuFields {
   }
 };
 
+/// The compressed integer arrays of the last binary frame of a series (connectivity, offsets,
+/// cell types, integer fields such as "level"), by array name. A frame whose integer array has
+/// the same bytes as the kept one of its name reuses its zlib blocks instead of compressing it
+/// again: between two cut changes a run's frames differ only in their floating-point arrays. The
+/// files are byte for byte those written without a cache. One per series; not for concurrent
+/// writers.
+class VtuArrayCache {
+ public:
+  /// The compressed bytes kept under `name` when they were made from exactly `raw[0, size)`,
+  /// else null.
+  const std::vector<std::uint8_t>* find(const std::string& name, const std::uint8_t* raw,
+                                        std::size_t size);
+  /// Keeps `compressed`, made from `raw[0, size)`, under `name` (in place of what was kept).
+  void keep(const std::string& name, const std::uint8_t* raw, std::size_t size,
+            std::vector<std::uint8_t> compressed);
+
+  std::size_t reused() const { return m_reused; }          ///< arrays taken from the cache
+  std::size_t compressed() const { return m_compressed; }  ///< arrays compressed and kept
+
+ private:
+  struct Entry {
+    std::vector<std::uint8_t> raw, compressed;
+  };
+  std::unordered_map<std::string, Entry> m_entries;
+  std::size_t m_reused = 0, m_compressed = 0;
+};
+
 /// Writes one frame as a .vtu, atomically: `positions` (#V × 3, current positions), `tets`
 /// (#T × 4, VTK cell type 10) and the named `fields` (Float64 / Int32 arrays), in `encoding`.
 /// Reading gives back the identical doubles in either encoding. Throws InputError naming the path
-/// and field when a field's row count does not match #V or #T.
+/// and field when a field's row count does not match #V or #T. With a `cache` (binary only), the
+/// integer arrays that repeat the previous frame's are not compressed again.
 void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
                ConstRef<MatrixX4i> tets, const VtuFields& fields = {},
-               VtkEncoding encoding = VtkEncoding::binary);
+               VtkEncoding encoding = VtkEncoding::binary, VtuArrayCache* cache = nullptr);
 
 /// Writes a rest mesh as .vtu (no fields).
 void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,

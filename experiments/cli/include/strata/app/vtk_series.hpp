@@ -42,6 +42,8 @@ class VtkSeries {
   int m_frames = 0;
   bool m_mesh_frames = true;
   VtkEncoding m_encoding = VtkEncoding::binary;
+  /// The integer arrays of the last frames (mesh and surface): between cut changes they repeat.
+  VtuArrayCache m_mesh_arrays, m_surface_arrays;
 };
 
 }  // namespace strata::app
