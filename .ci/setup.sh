@@ -15,7 +15,7 @@ packages=(
   build-essential cmake g++ make
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libsuitesparse-dev
   libopenblas0-pthread libgtest-dev libgmock-dev googletest libbenchmark-dev
-  libcgal-dev libcgal-demo libopenvdb-dev libboost-iostreams-dev zlib1g-dev libhypre-dev
+  libcgal-dev libcgal-demo libopenvdb-dev libboost-iostreams-dev zlib1g-dev libdeflate-dev libhypre-dev
   python3-matplotlib python3-meshio clang-format
 )
 
