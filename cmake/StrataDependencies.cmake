@@ -6,7 +6,7 @@ find_package(CLI11 REQUIRED)
 find_package(ZLIB REQUIRED)  # reading compressed VTK files
 
 # libdeflate (libdeflate-dev) writes the compressed VTK frames: zlib streams, 2–3 times faster
-# than zlib's own level 1. Only a pkg-config file: an imported target from find_path/find_library.
+# than zlib's own level 1. Only a pkg-config file: an interface target from find_path/find_library.
 find_path(LIBDEFLATE_INCLUDE_DIR libdeflate.h)
 find_library(LIBDEFLATE_LIBRARY deflate)
 if(NOT LIBDEFLATE_INCLUDE_DIR OR NOT LIBDEFLATE_LIBRARY)

@@ -9,8 +9,8 @@
 #   <libdir>/cmake/strata/                          strataConfig.cmake, strataConfigVersion.cmake,
 #                                                   strataTargets*.cmake
 #
-# Only Eigen is a public dependency (the headers use it). TBB, zlib, nlohmann_json, CHOLMOD and
-# hypre (with Open MPI) are private link dependencies of the shared libraries and do not appear in the exported interface; the
+# Only Eigen is a public dependency (the headers use it). TBB, zlib, libdeflate, nlohmann_json,
+# CHOLMOD and hypre (with Open MPI) are private link dependencies of the shared libraries and do not appear in the exported interface; the
 # warning and tuning targets are BUILD_INTERFACE only.
 include(CMakePackageConfigHelpers)
 include(StrataEigenAbi)

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <limits>
 
 #include "fem_test_utils.hpp"
 #include "strata/core/common/error.hpp"
@@ -295,14 +296,31 @@ TEST(ElasticModel, BadTetsAreReportedByIndexWhateverTheThreadCount) {
   TetMesh out_of_range = mesh;
   out_of_range.tets(700, 2) = static_cast<int>(mesh.vertices.rows()) + 5;
   out_of_range.tets(900, 1) = -3;
+  TetMesh far_out = mesh;  // far enough to fault if the partition read through it
+  far_out.tets(10, 0) = 1 << 30;
+  TetMesh no_vertices = mesh;  // the partition's bounding box has nothing to bound
+  no_vertices.vertices.resize(0, 3);
   TetMesh inverted = mesh;
   std::swap(inverted.tets(400, 1), inverted.tets(400, 2));
+  // A non-finite coordinate: the first tet holding that vertex is degenerate.
+  TetMesh not_finite = mesh;
+  const int bad_vertex = mesh.tets(300, 2);
+  not_finite.vertices(bad_vertex, 1) = std::numeric_limits<double>::quiet_NaN();
+  Index first_holder = 0;
+  while (!(mesh.tets.row(first_holder).array() == bad_vertex).any())
+    ++first_holder;
   for (const int threads : {1, 2}) {
     const ThreadLimit limit(threads);
     EXPECT_EQ(
         construction_error(out_of_range),
         "tet 700: vertex index " + std::to_string(mesh.vertices.rows() + 5) + " out of range");
+    EXPECT_EQ(construction_error(far_out),
+              "tet 10: vertex index " + std::to_string(1 << 30) + " out of range");
+    EXPECT_EQ(construction_error(no_vertices),
+              "tet 0: vertex index " + std::to_string(mesh.tets(0, 0)) + " out of range");
     EXPECT_EQ(construction_error(inverted), "tet 400 is inverted at rest");
+    EXPECT_EQ(construction_error(not_finite),
+              "tet " + std::to_string(first_holder) + " is degenerate at rest");
   }
 }
 

@@ -58,9 +58,13 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
     return partition;
   }
 
-  // Morton order of the tet centroids.
-  const Vector3d lower = positions.colwise().minCoeff().transpose();
-  const Vector3d extent = (positions.colwise().maxCoeff().transpose() - lower).cwiseMax(1e-300);
+  // Morton order of the tet centroids (no vertices: every tet is bad, and every key 0).
+  const bool has_vertices = positions.rows() > 0;
+  const Vector3d lower =
+      has_vertices ? Vector3d(positions.colwise().minCoeff().transpose()) : Vector3d::Zero();
+  const Vector3d extent =
+      has_vertices ? Vector3d((positions.colwise().maxCoeff().transpose() - lower).cwiseMax(1e-300))
+                   : Vector3d::Ones();
   // (code, tet) pairs, sorted by code; ties keep the tets' order (a stable sort from tet order).
   std::vector<std::pair<std::uint64_t, int>> keyed(num_tets);
   tbb::parallel_for(Index(0), num_tets, [&](Index t) {
@@ -72,7 +76,9 @@ TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX
     const Vector3d unit = ((0.25 * centroid - lower).array() / extent.array()).matrix();
     std::uint64_t key = 0;
     for (int axis = 0; axis < 3; ++axis) {
-      const auto cell = static_cast<std::uint64_t>(std::clamp(unit[axis], 0.0, 1.0) * 2097151.0);
+      // NaN (a non-finite coordinate, which the rest data reports) goes to 0.
+      const double u = unit[axis] > 0.0 ? std::min(unit[axis], 1.0) : 0.0;
+      const auto cell = static_cast<std::uint64_t>(u * 2097151.0);
       key |= spread_bits(cell) << axis;
     }
     keyed[t] = {key, static_cast<int>(t)};

@@ -1,3 +1,6 @@
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cstdint>
 #include <ostream>
 #include <string>
@@ -24,11 +27,14 @@ void write_vtu(const std::filesystem::path& path, ConstRef<MatrixX3d> positions,
 
   std::vector<std::int64_t> connectivity(static_cast<std::size_t>(4 * num_cells));
   std::vector<std::int64_t> offsets(static_cast<std::size_t>(num_cells));
-  for (Index t = 0; t < num_cells; ++t) {
-    for (int k = 0; k < 4; ++k)
-      connectivity[4 * t + k] = tets(t, k);
-    offsets[t] = 4 * (t + 1);
-  }
+  tbb::parallel_for(tbb::blocked_range<Index>(0, num_cells, 4096),
+                    [&](const tbb::blocked_range<Index>& range) {
+                      for (Index t = range.begin(); t != range.end(); ++t) {
+                        for (int k = 0; k < 4; ++k)
+                          connectivity[4 * t + k] = tets(t, k);
+                        offsets[t] = 4 * (t + 1);
+                      }
+                    });
   const std::vector<std::uint8_t> types(static_cast<std::size_t>(num_cells), kVtkTetra);
 
   write_file_atomically(path, [&](std::ostream& out) {

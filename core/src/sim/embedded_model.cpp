@@ -372,8 +372,8 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   if (9 * layer.indices.size() > std::size_t(std::numeric_limits<int>::max()))
     throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
 
-  // The scalar pattern of K_q and the assembly plan (element offsets, the layer's targets) need
-  // only the block lists: they are built side by side.
+  // The scalar pattern of K_q and the assembly plan (element offsets, the layer's targets) are
+  // built side by side: neither reads what the other writes.
   SparseMatrixd pattern;
   FillVector<int> block_targets;
   FillVector<WeightedTarget> weighted_targets;

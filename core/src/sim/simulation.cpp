@@ -50,8 +50,14 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
   if (options.first_step < 0) throw InputError("simulation: first_step must be >= 0");
   std::vector<char> referenced(m_mesh.vertices.rows(), 0);
   for (Index t = 0; t < m_mesh.tets.rows(); ++t)
-    for (int k = 0; k < 4; ++k)
-      referenced[m_mesh.tets(t, k)] = 1;
+    for (int k = 0; k < 4; ++k) {
+      const int v = m_mesh.tets(t, k);
+      if (v < 0 || v >= m_mesh.vertices.rows())
+        throw InputError("mesh: tet " + std::to_string(t) + " references vertex " +
+                         std::to_string(v) + " (mesh has " +
+                         std::to_string(m_mesh.vertices.rows()) + " vertices)");
+      referenced[v] = 1;
+    }
   for (size_t v = 0; v < referenced.size(); ++v)
     if (!referenced[v])
       throw InputError("mesh: vertex " + std::to_string(v) + " belongs to no tet");

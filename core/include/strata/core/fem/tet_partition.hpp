@@ -25,7 +25,8 @@ struct TetPartition {
 };
 
 /// Builds the schedule. `target_chunks` bounds the number of chunks (more chunks: better balance,
-/// more colours). Vertex indices out of range are skipped (the mesh's validation reports them).
+/// more colours). Vertex indices out of range are skipped and non-finite coordinates sort first
+/// (the rest data, compute_tet_rest_data, reports both).
 TetPartition build_tet_partition(ConstRef<MatrixX3d> positions, ConstRef<MatrixX4i> tets,
                                  int target_chunks = 256);
 
