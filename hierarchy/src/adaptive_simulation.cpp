@@ -488,6 +488,7 @@ SimulationOptions AdaptiveSimulation::flatten(long first_step) {
 
 double AdaptiveSimulation::rebuild(long first_step) {
   const auto start = Clock::now();
+  m_simulation_change = -1;
   SimulationOptions options = flatten(first_step);
   const double flatten_seconds = seconds_since(start);
   m_mesh_external = peak_loads(options);
@@ -746,6 +747,7 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   // memory it frees (one Simulation at a time: a lower peak, and a first change as fast as the
   // later ones). The state moved is the one passed in, so nothing else of it is needed.
   const VectorXd old_dof_vertex_mass = m_simulation->dof_vertex_mass();
+  note_solver_setups();
   SimulationCounters old_counters = m_simulation->counters();
   if (first_step < m_simulation->step_count()) old_counters.steps -= 1;  // a redone step
   // The cut before the change, restored if the change fails.
@@ -824,6 +826,15 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.seconds = std::chrono::duration<double>(phase - start).count();
   m_bookkeeping_seconds += record.seconds;
   m_changes.push_back(record);
+  m_simulation_change = static_cast<std::ptrdiff_t>(m_changes.size()) - 1;
+}
+
+void AdaptiveSimulation::note_solver_setups() {
+  if (m_simulation_change < 0 || !m_simulation) return;
+  const SimulationCounters counters = m_simulation->counters();
+  CutChangeRecord& record = m_changes[static_cast<std::size_t>(m_simulation_change)];
+  record.multigrid_setups = counters.multigrid_setups;
+  record.multigrid_setup_seconds = counters.multigrid_setup_seconds;
 }
 
 bool AdaptiveSimulation::adapting() const {
@@ -966,6 +977,7 @@ void AdaptiveSimulation::record_contact_step() {
 }
 
 void AdaptiveSimulation::record_sample() {
+  note_solver_setups();
   CutSample sample;
   sample.step = m_simulation->step_count();
   sample.time = m_simulation->time();

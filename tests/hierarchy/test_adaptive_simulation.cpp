@@ -295,6 +295,49 @@ TEST(AdaptiveSimulation, RefinementKeepsTheEnergyAndTheCutFollowsTheLoad) {
   EXPECT_EQ(sim.history().size(), static_cast<size_t>(sim.step_count() + 1));
 }
 
+TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
+  // The solve after a change builds the multigrid hierarchy of the new cut: each change's record
+  // holds the setups made on its cut, all of the run's but those on the initial cut. CHOLMOD
+  // builds none.
+  const PressedSlab slab;
+  for (const LinearSolverKind solver : {LinearSolverKind::multigrid, LinearSolverKind::cholmod}) {
+    SolverSettings settings;
+    settings.integrator = Integrator::implicit_euler;
+    settings.linear_solver = solver;
+    settings.dt = 2e-3;
+    settings.duration = 0.04;
+    // From level 1: the cuts have a coarse level of an eighth of their vertices (a space that
+    // shrinks less is merged into the next, and a single level is solved by CHOLMOD).
+    HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 1);
+    h.adapt_every = 2;
+    h.criteria.min_steps_between_changes = 2;
+    AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
+                           Vector3d::Zero(), settings);
+    run(sim);
+    ASSERT_GE(sim.changes().size(), 2u);
+    long recorded = 0;
+    for (const CutChangeRecord& change : sim.changes()) {
+      recorded += change.multigrid_setups;
+      if (solver == LinearSolverKind::cholmod) {
+        EXPECT_EQ(change.multigrid_setups, 0);
+        EXPECT_EQ(change.multigrid_setup_seconds, 0.0);
+        continue;
+      }
+      // Every change here is followed by a step on its cut (the last comes before the end).
+      EXPECT_GE(change.multigrid_setups, 1) << "change after step " << change.step;
+      EXPECT_GT(change.multigrid_setup_seconds, 0.0);
+    }
+    const SimulationCounters counters = sim.counters();
+    if (solver == LinearSolverKind::multigrid) {
+      // The initial cut's (at least its first solve) are the ones no change holds.
+      EXPECT_GE(counters.multigrid_setups - recorded, 1);
+      EXPECT_LE(recorded, counters.multigrid_setups);
+    } else {
+      EXPECT_EQ(counters.multigrid_setups, 0);
+    }
+  }
+}
+
 TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
   const PressedSlab slab;
   SolverSettings settings;

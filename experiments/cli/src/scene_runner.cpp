@@ -223,6 +223,8 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
                          {"stepper", change.phases.stepper},
                          {"transfer", change.phases.transfer},
                          {"records", change.phases.records}}},
+                       {"multigrid_setups", change.multigrid_setups},
+                       {"multigrid_setup_seconds", change.multigrid_setup_seconds},
                        {"plastic_merge_change", change.plastic_merge_change},
                        {"contact_correction", change.contact_correction}});
   }

@@ -150,6 +150,11 @@ struct CutChangeRecord {
   Vector3d momentum_after = Vector3d::Zero();   ///< … just after
   double seconds = 0.0;    ///< wall time of the change (edit, flatten, rebuild, transfer, records)
   CutChangePhases phases;  ///< … by part
+  /// Multigrid hierarchies built on the cut this change made (the first by the solve after the
+  /// change: Galerkin products, smoothers, coarse factor; more where the solver found them
+  /// stale) and their wall time [s]. Not in `seconds`: the steps on the cut include them.
+  long multigrid_setups = 0;
+  double multigrid_setup_seconds = 0.0;
   /// Plastic materials: largest |ε̄ₚ(child) − ε̄ₚ(parent)| over the merges of this change (the
   /// detail a merge averages away; 0 without merges or plasticity).
   double plastic_merge_change = 0.0;
@@ -355,6 +360,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// Makes the cut every node at the deepest level; the nodes it refined.
   Index edit_to_full_resolution();
   void record_sample();
+  /// The multigrid setups of m_simulation so far into the change record that built it.
+  void note_solver_setups();
   /// Obstacles: the contact record of the step just accepted (before a coarsening rebuilds the
   /// Simulation).
   void record_contact_step();
@@ -437,6 +444,8 @@ class AdaptiveSimulation final : public SimulationRun {
   std::unique_ptr<Simulation> m_simulation;
 
   std::vector<CutChangeRecord> m_changes;
+  /// The change record whose cut m_simulation was built on; −1 for another rebuild.
+  std::ptrdiff_t m_simulation_change = -1;
   std::vector<CutSample> m_history;
   SimulationCounters m_finished_counters;  ///< of the Simulations already replaced
   double m_bookkeeping_seconds = 0.0;
