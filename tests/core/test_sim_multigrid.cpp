@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -81,6 +82,81 @@ TEST(Multigrid, GalerkinProductMatchesEigen) {
     for (Index j = 0; j < C.outerSize(); ++j)  // rows sorted within each column
       for (auto p = C.outerIndexPtr()[j] + 1; p < C.outerIndexPtr()[j + 1]; ++p)
         EXPECT_LT(C.innerIndexPtr()[p - 1], C.innerIndexPtr()[p]);
+  }
+}
+
+/// The bits of a sparse matrix: its pattern and values.
+bool same_bits(const SparseMatrixd& a, const SparseMatrixd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a.nonZeros() == b.nonZeros() &&
+         std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1, b.outerIndexPtr()) &&
+         std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr()) &&
+         std::memcmp(a.valuePtr(), b.valuePtr(), sizeof(double) * a.nonZeros()) == 0;
+}
+
+TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
+  // A by whole 3 × 3 blocks (blocks that differ, as a stiffness has) and P = P_v ⊗ I₃: the
+  // blocked product adds the scalar one's products in its order. A P with one DOF dropped (a
+  // vertex fixed in x only) or a pattern of partial blocks goes entry by entry; all agree with
+  // Eigen's product.
+  std::mt19937 random(17u);
+  for (const Index nv : {Index(40), Index(2500)}) {
+    const SparseMatrixd S = random_spd(nv, 5, random);
+    std::vector<Eigen::Triplet<double>> triplets;
+    std::uniform_real_distribution<double> value(-1.0, 1.0);
+    for (Index j = 0; j < S.outerSize(); ++j)
+      for (SparseMatrixd::InnerIterator it(S, j); it; ++it) {
+        if (it.row() > j) continue;
+        Eigen::Matrix3d B = Eigen::Matrix3d::NullaryExpr([&] { return value(random); });
+        if (it.row() == j) B = B * B.transpose() + 3.0 * Eigen::Matrix3d::Identity();
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) {
+            triplets.emplace_back(3 * it.row() + r, 3 * j + c, it.value() * B(r, c));
+            if (it.row() != j)
+              triplets.emplace_back(3 * j + c, 3 * it.row() + r, it.value() * B(r, c));
+          }
+      }
+    SparseMatrixd A(3 * nv, 3 * nv);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    const SparseMatrixd Pv = random_prolongation(nv, nv / 5, random);
+    std::vector<Eigen::Triplet<double>> weights;  // P_v ⊗ I₃ without the zeros off the diagonal
+    for (Index j = 0; j < Pv.outerSize(); ++j)
+      for (SparseMatrixd::InnerIterator it(Pv, j); it; ++it)
+        for (int c = 0; c < 3; ++c)
+          weights.emplace_back(3 * it.row() + c, 3 * j + c, it.value());
+    SparseMatrixd P(3 * Pv.rows(), 3 * Pv.cols());
+    P.setFromTriplets(weights.begin(), weights.end());
+    ASSERT_TRUE(galerkin_product_by_blocks(A, P));
+    const SparseMatrixd blocked = galerkin_product(A, P);
+    const SparseMatrixd scalar = scalar_galerkin_product(A, P);
+    EXPECT_TRUE(same_bits(blocked, scalar)) << nv;
+    const SparseMatrixd expected = SparseMatrixd(P.transpose()) * (A * P);
+    EXPECT_LE((Eigen::MatrixXd(blocked) - Eigen::MatrixXd(expected)).cwiseAbs().maxCoeff(),
+              1e-12 * Eigen::MatrixXd(expected).cwiseAbs().maxCoeff());
+    // One fine DOF dropped: rows of P no longer come in triples.
+    std::vector<Eigen::Triplet<double>> kept;
+    for (Index j = 0; j < P.outerSize(); ++j)
+      for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
+        if (it.row() != 3) kept.emplace_back(it.row() < 3 ? it.row() : it.row() - 1, j, it.value());
+    SparseMatrixd P_dropped(P.rows() - 1, P.cols());
+    P_dropped.setFromTriplets(kept.begin(), kept.end());
+    SparseMatrixd A_dropped(A.rows() - 1, A.cols() - 1);
+    {
+      std::vector<Eigen::Triplet<double>> entries;
+      for (Index j = 0; j < A.outerSize(); ++j)
+        for (SparseMatrixd::InnerIterator it(A, j); it; ++it)
+          if (it.row() != 3 && j != 3)
+            entries.emplace_back(it.row() < 3 ? it.row() : it.row() - 1, j < 3 ? j : j - 1,
+                                 it.value());
+      A_dropped.setFromTriplets(entries.begin(), entries.end());
+    }
+    EXPECT_FALSE(galerkin_product_by_blocks(A_dropped, P_dropped));
+    EXPECT_FALSE(galerkin_product_by_blocks(A, kron3(Pv, Eigen::Matrix3d::Identity())));  // zeros
+    const SparseMatrixd C = galerkin_product(A_dropped, P_dropped);
+    const SparseMatrixd expected_dropped =
+        SparseMatrixd(P_dropped.transpose()) * (A_dropped * P_dropped);
+    EXPECT_TRUE(same_bits(C, scalar_galerkin_product(A_dropped, P_dropped)));
+    EXPECT_LE((Eigen::MatrixXd(C) - Eigen::MatrixXd(expected_dropped)).cwiseAbs().maxCoeff(),
+              1e-12 * Eigen::MatrixXd(expected_dropped).cwiseAbs().maxCoeff());
   }
 }
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -144,7 +145,210 @@ double symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd&
   return after ? sum_over_vector_chunks(y.size(), after) : 0.0;
 }
 
+namespace {
+
+/// A sparse matrix by vertices: the column lists of an nv × mv pattern, with the positions of
+/// its entries in the scalar matrix it came from.
+struct VertexColumns {
+  std::vector<int> outer;  ///< mv + 1
+  std::vector<int> rows;   ///< vertex row of each entry
+  std::vector<int> at;     ///< the entry's (0, 0) value in the scalar matrix's values
+};
+
+/// P = P_v ⊗ I₃ — the three DOFs of each vertex prolonged alike, columns 3j + c holding rows
+/// 3i + c with equal weights — as P_v's columns; nothing otherwise (a vertex with some but not
+/// all DOFs constrained).
+std::optional<VertexColumns> vertex_prolongation(const SparseMatrixd& P) {
+  if (!P.isCompressed() || P.rows() % 3 != 0 || P.cols() % 3 != 0) return std::nullopt;
+  const int* outer = P.outerIndexPtr();
+  const int* inner = P.innerIndexPtr();
+  const double* values = P.valuePtr();
+  VertexColumns result;
+  const Index mv = P.cols() / 3;
+  result.outer.assign(mv + 1, 0);
+  result.rows.reserve(P.nonZeros() / 3);
+  result.at.reserve(P.nonZeros() / 3);
+  for (Index j = 0; j < mv; ++j) {
+    const int first = outer[3 * j];
+    const int count = outer[3 * j + 1] - first;
+    for (int c = 1; c < 3; ++c)
+      if (outer[3 * j + c + 1] - outer[3 * j + c] != count) return std::nullopt;
+    for (int k = 0; k < count; ++k) {
+      const int row = inner[first + k];
+      if (row % 3 != 0) return std::nullopt;
+      for (int c = 1; c < 3; ++c) {
+        const int other = outer[3 * j + c] + k;
+        if (inner[other] != row + c || values[other] != values[first + k]) return std::nullopt;
+      }
+      result.rows.push_back(row / 3);
+      result.at.push_back(first + k);
+    }
+    result.outer[j + 1] = static_cast<int>(result.rows.size());
+  }
+  return result;
+}
+
+/// A by 3 × 3 blocks when each vertex column's three scalar columns hold the same complete row
+/// triples (3a, 3a + 1, 3a + 2): block (a, b) entry (r, c) at values[at + r + c · 3 · (column
+/// length)] … given as the block's (0, 0) position and its column's stride.
+struct VertexBlocks {
+  VertexColumns columns;
+  std::vector<int> stride;  ///< per vertex column b: the distance between its scalar columns
+};
+
+std::optional<VertexBlocks> vertex_blocks(const SparseMatrixd& A) {
+  if (!A.isCompressed() || A.rows() % 3 != 0 || A.cols() != A.rows()) return std::nullopt;
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  VertexBlocks result;
+  const Index nv = A.cols() / 3;
+  result.columns.outer.assign(nv + 1, 0);
+  result.stride.resize(nv);
+  result.columns.rows.reserve(A.nonZeros() / 9);
+  result.columns.at.reserve(A.nonZeros() / 9);
+  for (Index b = 0; b < nv; ++b) {
+    const int first = outer[3 * b];
+    const int count = outer[3 * b + 1] - first;
+    if (count % 3 != 0) return std::nullopt;
+    for (int c = 1; c < 3; ++c)
+      if (outer[3 * b + c + 1] - outer[3 * b + c] != count ||
+          !std::equal(inner + first, inner + first + count, inner + outer[3 * b + c]))
+        return std::nullopt;
+    for (int k = 0; k < count; k += 3) {
+      const int row = inner[first + k];
+      if (row % 3 != 0 || inner[first + k + 1] != row + 1 || inner[first + k + 2] != row + 2)
+        return std::nullopt;
+      result.columns.rows.push_back(row / 3);
+      result.columns.at.push_back(first + k);
+    }
+    result.columns.outer[b + 1] = static_cast<int>(result.columns.rows.size());
+    result.stride[b] = count;
+  }
+  return result;
+}
+
+/// PᵀAP by 3 × 3 blocks (P = P_v ⊗ I₃, A by blocks): the same products added in the same order
+/// as the scalar product below, entry by entry, so the result is bit for bit the same.
+SparseMatrixd blocked_galerkin_product(const SparseMatrixd& A, const VertexBlocks& blocks,
+                                       const SparseMatrixd& P, const VertexColumns& Pv) {
+  const Index mv = P.cols() / 3;
+  const double* a_values = A.valuePtr();
+  const double* p_values = P.valuePtr();
+  // P_v's rows: for each fine vertex a, the coarse vertices I and the positions of w_aI.
+  const Index nv = A.cols() / 3;
+  VertexColumns rows_of;
+  rows_of.outer.assign(nv + 1, 0);
+  for (const int a : Pv.rows)
+    ++rows_of.outer[a + 1];
+  for (Index a = 0; a < nv; ++a)
+    rows_of.outer[a + 1] += rows_of.outer[a];
+  rows_of.rows.resize(Pv.rows.size());
+  rows_of.at.resize(Pv.rows.size());
+  {
+    std::vector<int> next(rows_of.outer.begin(), rows_of.outer.end() - 1);
+    for (Index J = 0; J < mv; ++J)
+      for (int k = Pv.outer[J]; k < Pv.outer[J + 1]; ++k) {
+        const int slot = next[Pv.rows[k]]++;
+        rows_of.rows[slot] = static_cast<int>(J);
+        rows_of.at[slot] = Pv.at[k];
+      }
+  }
+  constexpr Index kBlock = 170;  // vertex columns per task (about 512 scalar columns)
+  const Index num_blocks = (mv + kBlock - 1) / kBlock;
+  struct Fragment {
+    std::vector<int> counts;  // per scalar column
+    std::vector<int> rows;
+    std::vector<double> values;
+  };
+  std::vector<Fragment> fragments(num_blocks);
+  struct Accumulator {
+    std::vector<double> value;  // 9 per coarse vertex: (r, c) at 3c + r
+    std::vector<Index> mark;
+    std::vector<int> touched;
+  };
+  tbb::enumerable_thread_specific<Accumulator> accumulators;
+  tbb::parallel_for(Index(0), num_blocks, [&](Index block) {
+    Accumulator& acc = accumulators.local();
+    if (static_cast<Index>(acc.mark.size()) != mv) {
+      acc.value.assign(9 * mv, 0.0);
+      acc.mark.assign(mv, -1);
+    }
+    Fragment& fragment = fragments[block];
+    const Index first = block * kBlock;
+    const Index last = std::min(mv, first + kBlock);
+    for (Index J = first; J < last; ++J) {
+      acc.touched.clear();
+      for (int p = Pv.outer[J]; p < Pv.outer[J + 1]; ++p) {
+        const int b = Pv.rows[p];
+        const double w_bJ = p_values[Pv.at[p]];
+        const int stride = blocks.stride[b];
+        for (int e = blocks.columns.outer[b]; e < blocks.columns.outer[b + 1]; ++e) {
+          const int a = blocks.columns.rows[e];
+          const double* block_ab = a_values + blocks.columns.at[e];
+          double ap[9];  // A(3a + r, 3b + c) · w_bJ at 3c + r
+          for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r)
+              ap[3 * c + r] = block_ab[r + c * stride] * w_bJ;
+          for (int q = rows_of.outer[a]; q < rows_of.outer[a + 1]; ++q) {
+            const int I = rows_of.rows[q];
+            const double w_aI = p_values[rows_of.at[q]];
+            double* value = &acc.value[9 * static_cast<Index>(I)];
+            if (acc.mark[I] != J) {
+              acc.mark[I] = J;
+              std::fill(value, value + 9, 0.0);
+              acc.touched.push_back(I);
+            }
+            for (int k = 0; k < 9; ++k)
+              value[k] += w_aI * ap[k];
+          }
+        }
+      }
+      std::sort(acc.touched.begin(), acc.touched.end());
+      for (int c = 0; c < 3; ++c) {
+        fragment.counts.push_back(3 * static_cast<int>(acc.touched.size()));
+        for (const int I : acc.touched)
+          for (int r = 0; r < 3; ++r) {
+            fragment.rows.push_back(3 * I + r);
+            fragment.values.push_back(acc.value[9 * static_cast<Index>(I) + 3 * c + r]);
+          }
+      }
+    }
+  });
+  Index nonzeros = 0;
+  for (const Fragment& fragment : fragments)
+    nonzeros += static_cast<Index>(fragment.rows.size());
+  SparseMatrixd C(3 * mv, 3 * mv);
+  C.resizeNonZeros(nonzeros);
+  auto* outer = C.outerIndexPtr();
+  outer[0] = 0;
+  Index column = 0, offset = 0;
+  for (const Fragment& fragment : fragments) {
+    for (const int count : fragment.counts) {
+      outer[column + 1] = static_cast<int>(outer[column] + count);
+      ++column;
+    }
+    std::copy(fragment.rows.begin(), fragment.rows.end(), C.innerIndexPtr() + offset);
+    std::copy(fragment.values.begin(), fragment.values.end(), C.valuePtr() + offset);
+    offset += static_cast<Index>(fragment.rows.size());
+  }
+  return C;
+}
+
+}  // namespace
+
+bool galerkin_product_by_blocks(const SparseMatrixd& A, const SparseMatrixd& P) {
+  return A.rows() == P.rows() && vertex_prolongation(P).has_value() && vertex_blocks(A).has_value();
+}
+
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
+  if (A.rows() == P.rows())
+    if (const std::optional<VertexColumns> Pv = vertex_prolongation(P))
+      if (const std::optional<VertexBlocks> blocks = vertex_blocks(A))
+        return blocked_galerkin_product(A, *blocks, P, *Pv);
+  return scalar_galerkin_product(A, P);
+}
+
+SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
   const Index m = P.cols();
   const SparseMatrixd PT = P.transpose();  // column i of PT = row i of P
   // Column blocks computed in parallel, each into its own compressed fragment.

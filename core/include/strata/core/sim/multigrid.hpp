@@ -78,8 +78,14 @@ struct MultigridOptions {
 };
 
 /// PᵀAP for a symmetric A (both triangles, column-major), computed column by column in parallel
-/// (no intermediate A P); the result has both triangles, rows sorted in each column.
+/// (no intermediate A P); the result has both triangles, rows sorted in each column. When P
+/// prolongs each vertex's three DOFs alike (P = P_v ⊗ I₃) and A's pattern is made of whole 3 × 3
+/// vertex blocks, by blocks; otherwise entry by entry (scalar_galerkin_product). Both add the
+/// same products in the same order: the results are the same bit for bit.
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
+SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
+/// Whether galerkin_product(A, P) goes by blocks.
+bool galerkin_product_by_blocks(const SparseMatrixd& A, const SparseMatrixd& P);
 
 class MultigridPreconditioner {
  public:
