@@ -500,6 +500,15 @@ double AdaptiveSimulation::rebuild(long first_step) {
 }
 
 void AdaptiveSimulation::advance() {
+  try {
+    advance_step();
+  } catch (...) {
+    note_solver_setups();  // a step that failed made its setups on the current cut as well
+    throw;
+  }
+}
+
+void AdaptiveSimulation::advance_step() {
   if (m_failed) throw std::logic_error("AdaptiveSimulation::advance: a previous cut change failed");
   if (adapting() && !is_static(m_solver) && m_settings.in_step_refinement) {
     advance_with_redo();

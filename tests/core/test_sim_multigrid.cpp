@@ -132,7 +132,7 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
     const SparseMatrixd expected = SparseMatrixd(P.transpose()) * (A * P);
     EXPECT_LE((Eigen::MatrixXd(blocked) - Eigen::MatrixXd(expected)).cwiseAbs().maxCoeff(),
               1e-12 * Eigen::MatrixXd(expected).cwiseAbs().maxCoeff());
-    // One fine DOF dropped: rows of P no longer come in triples.
+    // One fine DOF dropped (a vertex fixed in x only): rows of P no longer come in triples.
     std::vector<Eigen::Triplet<double>> kept;
     for (Index j = 0; j < P.outerSize(); ++j)
       for (SparseMatrixd::InnerIterator it(P, j); it; ++it)
@@ -150,6 +150,23 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
       A_dropped.setFromTriplets(entries.begin(), entries.end());
     }
     EXPECT_FALSE(galerkin_product_by_blocks(A_dropped, P_dropped));
+    // Sizes that are multiples of 3 whose structure is not by vertices: one weight that differs
+    // between a vertex's components; A with an entry of an off-diagonal block removed; A with a
+    // stored zero in a block (still whole blocks: by blocks, and the same bits).
+    SparseMatrixd P_uneven = P;
+    P_uneven.valuePtr()[P_uneven.outerIndexPtr()[1]] *= 1.5;  // column 1: component y of vertex 0
+    EXPECT_FALSE(galerkin_product_by_blocks(A, P_uneven));
+    EXPECT_TRUE(same_bits(galerkin_product(A, P_uneven), scalar_galerkin_product(A, P_uneven)));
+    SparseMatrixd A_partial = A;  // entries (y of a, z of b) of off-diagonal blocks removed
+    A_partial.prune([](Index row, Index col, double) {
+      return !(row / 3 != col / 3 && row % 3 == 1 && col % 3 == 2);
+    });
+    EXPECT_FALSE(galerkin_product_by_blocks(A_partial, P));
+    EXPECT_TRUE(same_bits(galerkin_product(A_partial, P), scalar_galerkin_product(A_partial, P)));
+    SparseMatrixd A_zero = A;
+    A_zero.valuePtr()[A_zero.outerIndexPtr()[4] + 1] = 0.0;  // stored, not removed
+    EXPECT_TRUE(galerkin_product_by_blocks(A_zero, P));
+    EXPECT_TRUE(same_bits(galerkin_product(A_zero, P), scalar_galerkin_product(A_zero, P)));
     EXPECT_FALSE(galerkin_product_by_blocks(A, kron3(Pv, Eigen::Matrix3d::Identity())));  // zeros
     const SparseMatrixd C = galerkin_product(A_dropped, P_dropped);
     const SparseMatrixd expected_dropped =

@@ -298,6 +298,8 @@ SparseMatrixd blocked_galerkin_product(const SparseMatrixd& A, const VertexBlock
               std::fill(value, value + 9, 0.0);
               acc.touched.push_back(I);
             }
+            // w_aI · (A · w_bJ), as the scalar product forms it (the same rounding, and the same
+            // contraction into fused multiply-adds): keep the two expressions alike.
             for (int k = 0; k < 9; ++k)
               value[k] += w_aI * ap[k];
           }

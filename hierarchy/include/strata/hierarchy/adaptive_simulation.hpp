@@ -360,6 +360,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// Makes the cut every node at the deepest level; the nodes it refined.
   Index edit_to_full_resolution();
   void record_sample();
+  /// One step of advance() (which keeps the change records' setups on failure too).
+  void advance_step();
   /// The multigrid setups of m_simulation so far into the change record that built it.
   void note_solver_setups();
   /// Obstacles: the contact record of the step just accepted (before a coarsening rebuilds the
