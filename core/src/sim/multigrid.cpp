@@ -147,6 +147,35 @@ double symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd&
 
 namespace {
 
+/// Consecutive columns of a compressed matrix, computed apart (one task each).
+struct Fragment {
+  std::vector<int> counts;  ///< entries per column
+  std::vector<int> rows;
+  std::vector<double> values;
+};
+
+/// The n × n matrix whose columns are those of `fragments`, in order.
+SparseMatrixd joined(const std::vector<Fragment>& fragments, Index n) {
+  Index nonzeros = 0;
+  for (const Fragment& fragment : fragments)
+    nonzeros += static_cast<Index>(fragment.rows.size());
+  SparseMatrixd C(n, n);
+  C.resizeNonZeros(nonzeros);
+  auto* outer = C.outerIndexPtr();
+  outer[0] = 0;
+  Index column = 0, offset = 0;
+  for (const Fragment& fragment : fragments) {
+    for (const int count : fragment.counts) {
+      outer[column + 1] = static_cast<int>(outer[column] + count);
+      ++column;
+    }
+    std::copy(fragment.rows.begin(), fragment.rows.end(), C.innerIndexPtr() + offset);
+    std::copy(fragment.values.begin(), fragment.values.end(), C.valuePtr() + offset);
+    offset += static_cast<Index>(fragment.rows.size());
+  }
+  return C;
+}
+
 /// A sparse matrix by vertices: the column lists of an nv × mv pattern, with the positions of
 /// its entries in the scalar matrix it came from.
 struct VertexColumns {
@@ -255,11 +284,6 @@ SparseMatrixd blocked_galerkin_product(const SparseMatrixd& A, const VertexBlock
   }
   constexpr Index kBlock = 170;  // vertex columns per task (about 512 scalar columns)
   const Index num_blocks = (mv + kBlock - 1) / kBlock;
-  struct Fragment {
-    std::vector<int> counts;  // per scalar column
-    std::vector<int> rows;
-    std::vector<double> values;
-  };
   std::vector<Fragment> fragments(num_blocks);
   struct Accumulator {
     std::vector<double> value;  // 9 per coarse vertex: (r, c) at 3c + r
@@ -316,24 +340,7 @@ SparseMatrixd blocked_galerkin_product(const SparseMatrixd& A, const VertexBlock
       }
     }
   });
-  Index nonzeros = 0;
-  for (const Fragment& fragment : fragments)
-    nonzeros += static_cast<Index>(fragment.rows.size());
-  SparseMatrixd C(3 * mv, 3 * mv);
-  C.resizeNonZeros(nonzeros);
-  auto* outer = C.outerIndexPtr();
-  outer[0] = 0;
-  Index column = 0, offset = 0;
-  for (const Fragment& fragment : fragments) {
-    for (const int count : fragment.counts) {
-      outer[column + 1] = static_cast<int>(outer[column] + count);
-      ++column;
-    }
-    std::copy(fragment.rows.begin(), fragment.rows.end(), C.innerIndexPtr() + offset);
-    std::copy(fragment.values.begin(), fragment.values.end(), C.valuePtr() + offset);
-    offset += static_cast<Index>(fragment.rows.size());
-  }
-  return C;
+  return joined(fragments, 3 * mv);
 }
 
 }  // namespace
@@ -356,11 +363,6 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
   // Column blocks computed in parallel, each into its own compressed fragment.
   constexpr Index kBlock = 512;
   const Index num_blocks = (m + kBlock - 1) / kBlock;
-  struct Fragment {
-    std::vector<int> counts;
-    std::vector<int> rows;
-    std::vector<double> values;
-  };
   std::vector<Fragment> fragments(num_blocks);
   struct Accumulator {
     std::vector<double> value;
@@ -400,24 +402,7 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
       }
     }
   });
-  Index nonzeros = 0;
-  for (const Fragment& fragment : fragments)
-    nonzeros += static_cast<Index>(fragment.rows.size());
-  SparseMatrixd C(m, m);
-  C.resizeNonZeros(nonzeros);
-  auto* outer = C.outerIndexPtr();
-  outer[0] = 0;
-  Index column = 0, offset = 0;
-  for (const Fragment& fragment : fragments) {
-    for (const int count : fragment.counts) {
-      outer[column + 1] = static_cast<int>(outer[column] + count);
-      ++column;
-    }
-    std::copy(fragment.rows.begin(), fragment.rows.end(), C.innerIndexPtr() + offset);
-    std::copy(fragment.values.begin(), fragment.values.end(), C.valuePtr() + offset);
-    offset += static_cast<Index>(fragment.rows.size());
-  }
-  return C;
+  return joined(fragments, m);
 }
 
 namespace {
