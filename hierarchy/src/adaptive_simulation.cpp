@@ -486,10 +486,12 @@ SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   return options;
 }
 
-double AdaptiveSimulation::rebuild(long first_step) {
+double AdaptiveSimulation::rebuild(long first_step,
+                                   std::vector<SmootherEstimate> smoother_estimates) {
   const auto start = Clock::now();
   m_simulation_change = -1;
   SimulationOptions options = flatten(first_step);
+  options.smoother_estimates = std::move(smoother_estimates);
   const double flatten_seconds = seconds_since(start);
   m_mesh_external = peak_loads(options);
   m_simulation = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
@@ -767,12 +769,15 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.refined = counts.refined + counts.balance_refined + full_resolution_refined;
   record.coarsened = counts.coarsened;
 
+  // The smoothers' eigenvalue estimates carry over: the levels of the new cut are mostly those of
+  // the old one, changed where the cut changed.
+  std::vector<SmootherEstimate> smoother_estimates = m_simulation->smoother_estimates();
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
   m_finished_counters = add(m_finished_counters, old_counters);
   m_simulation.reset();
   try {
     record.phases.edit = lap();
-    record.phases.flatten = rebuild(first_step);
+    record.phases.flatten = rebuild(first_step, std::move(smoother_estimates));
     const SimulationBuildSeconds& built = m_simulation->build_seconds();
     record.phases.elastic_model = built.elastic_model;
     record.phases.reduced_model = built.reduced_model;

@@ -338,6 +338,52 @@ TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
   }
 }
 
+TEST(AdaptiveSimulation, ACutChangeSeedsTheNewCutsSmoothersWithThoseOfTheCutBefore) {
+  // The first multigrid setup on a new cut takes the smoothers' Lanczos estimates of the cut the
+  // change left, level by level where the level's size stays within a factor 2
+  // (MultigridPreconditioner::seed_smoother_estimates).
+  const PressedSlab slab;
+  SolverSettings settings;
+  settings.integrator = Integrator::implicit_euler;
+  settings.linear_solver = LinearSolverKind::multigrid;
+  settings.dt = 2e-3;
+  settings.duration = 0.04;
+  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 1);
+  h.adapt_every = 2;
+  h.criteria.min_steps_between_changes = 2;
+  AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
+                         Vector3d::Zero(), settings);
+  std::vector<SmootherEstimate> left;  // of the cut a change left, until the new cut's first setup
+  int compared_levels = 0;
+  while (!sim.finished()) {
+    const std::vector<SmootherEstimate> before = sim.current().smoother_estimates();
+    const std::size_t changes = sim.changes().size();
+    sim.advance();
+    if (sim.changes().size() == changes + 1) {
+      left = before;
+    } else if (sim.changes().size() > changes + 1) {
+      left.clear();  // several changes in one step: the cut between them is not observed
+    }
+    if (left.empty()) continue;
+    const long setups = sim.current().counters().multigrid_setups;
+    if (setups == 0) continue;  // no solve on the new cut yet
+    if (setups == 1) {
+      const std::vector<SmootherEstimate> now = sim.current().smoother_estimates();
+      if (now.size() == left.size()) {
+        for (std::size_t k = 0; k < now.size(); ++k) {
+          if (2 * left[k].rows < now[k].rows || left[k].rows > 2 * now[k].rows) continue;
+          EXPECT_EQ(now[k].lambda, left[k].lambda)
+              << "level " << k + 1 << " after step " << sim.changes().back().step;
+          ++compared_levels;
+        }
+      }
+    }
+    left.clear();
+  }
+  ASSERT_GE(sim.changes().size(), 2u);
+  EXPECT_GE(compared_levels, 1);
+}
+
 TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
   const PressedSlab slab;
   SolverSettings settings;

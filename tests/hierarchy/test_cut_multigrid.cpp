@@ -4,6 +4,8 @@
 // at ν = 0.3 and 0.49, with iteration counts that stay bounded as the box is refined.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "strata/core/fem/elastic_model.hpp"
@@ -250,6 +252,106 @@ TEST(CutMultigrid, RefusesIndefiniteAndReusesTheHierarchy) {
   ASSERT_TRUE(solver.solve(A, b, x));
   ASSERT_TRUE(direct.solve(A, b, expected));
   EXPECT_LE((x - expected).norm(), 1e-8 * expected.norm());
+}
+
+// A cut change seeds the next cut's smoothers with the Lanczos estimates of the cut before
+// (MultigridPreconditioner::seed_smoother_estimates). On two neighbouring cuts of the beam (the
+// second refines a band next to the first's refined end) the seeded levels take the seeds as
+// their estimates, those within 10 % of what Lanczos measures on the new cut, and multigrid-PCG
+// on the seeded hierarchy reaches the direct solution in at most one iteration more than on a
+// measured one. A level whose size is off by more than a factor 2 measures its own.
+TEST(CutMultigrid, SmootherEstimatesCarryOverToANeighbouringCut) {
+  for (const double nu : {0.3, 0.49}) {
+    SCOPED_TRACE("nu " + std::to_string(nu));
+    TetTree tree(beam(), 3);
+    const ActiveCut before = graded_cut(tree, 1, 3);
+    ActiveCut after = before;
+    for (const NodeId n : before.sorted_nodes()) {
+      const double x = tree.tet_positions(n).row(0).minCoeff();
+      if (tree.level(n) == 1 && x >= 0.6 && x < 1.0) after.refine(n);
+    }
+    ASSERT_GT(after.size(), before.size());
+    const ClampedSystem old_system = clamped_system(before, nu);
+    const ClampedSystem system = clamped_system(after, nu);
+
+    SpdSolver old_solver(LinearSolverKind::multigrid);
+    old_solver.use_nested_spaces(&old_system.spaces, old_system.free_dofs);
+    EXPECT_TRUE(old_solver.smoother_estimates().empty());  // before any setup
+    VectorXd x_old;
+    ASSERT_TRUE(old_solver.solve(old_system.A, old_system.b, x_old));
+    const std::vector<SmootherEstimate> seeds = old_solver.smoother_estimates();
+    ASSERT_EQ(static_cast<int>(seeds.size()), old_solver.multigrid_levels() - 1);
+
+    const std::vector<SparseMatrixd> prolongations =
+        free_dof_prolongations(system.spaces, system.free_dofs);
+    MultigridPreconditioner measured(prolongations);
+    ASSERT_TRUE(measured.setup(system.A));
+    const std::vector<SmootherEstimate> own = measured.smoother_estimates();
+    ASSERT_EQ(own.size(), seeds.size());
+    MultigridPreconditioner seeded(prolongations);
+    seeded.seed_smoother_estimates(seeds);
+    ASSERT_TRUE(seeded.setup(system.A));
+    const std::vector<SmootherEstimate> taken = seeded.smoother_estimates();
+    for (std::size_t k = 0; k < seeds.size(); ++k) {
+      SCOPED_TRACE("level " + std::to_string(k + 1));
+      EXPECT_EQ(taken[k].rows, own[k].rows);
+      ASSERT_TRUE(2 * seeds[k].rows >= own[k].rows && seeds[k].rows <= 2 * own[k].rows);
+      EXPECT_EQ(taken[k].lambda, seeds[k].lambda);
+      EXPECT_NEAR(seeds[k].lambda, own[k].lambda, 0.1 * own[k].lambda);
+      const auto [lower, upper] = seeded.smoother_interval(static_cast<int>(k) + 1);
+      EXPECT_EQ(lower, MultigridOptions().chebyshev_lower * seeds[k].lambda);
+      EXPECT_LE(upper, 1.2 * seeds[k].lambda);
+      EXPECT_GE(upper, seeds[k].lambda);
+    }
+    // Used by one setup: the next measures.
+    ASSERT_TRUE(seeded.setup(system.A));
+    for (std::size_t k = 0; k < seeds.size(); ++k)
+      EXPECT_EQ(seeded.smoother_estimates()[k].lambda, own[k].lambda);
+
+    SpdSolver direct(LinearSolverKind::cholmod);
+    VectorXd x_direct;
+    ASSERT_TRUE(direct.solve(system.A, system.b, x_direct));
+    long iterations[2] = {0, 0};
+    for (const bool seed : {false, true}) {
+      SpdSolver solver(LinearSolverKind::multigrid);
+      solver.use_nested_spaces(&system.spaces, system.free_dofs);
+      if (seed) solver.seed_smoother_estimates(seeds);
+      VectorXd x;
+      ASSERT_TRUE(solver.solve(system.A, system.b, x));
+      EXPECT_EQ(solver.direct_fallbacks(), 0);
+      EXPECT_LE((x - x_direct).norm(), 1e-8 * x_direct.norm()) << (seed ? "seeded" : "measured");
+      iterations[seed ? 1 : 0] = solver.cg_iterations();
+      if (seed) {
+        for (std::size_t k = 0; k < seeds.size(); ++k)
+          EXPECT_EQ(solver.smoother_estimates()[k].lambda, seeds[k].lambda);
+      }
+    }
+    EXPECT_LE(iterations[1], iterations[0] + 1);
+    RecordProperty("nu " + std::to_string(nu), std::to_string(iterations[0]) + " measured, " +
+                                                   std::to_string(iterations[1]) + " seeded");
+
+    // A level whose unknowns are more than twice the estimate's measures its own.
+    std::vector<SmootherEstimate> small = seeds;
+    for (SmootherEstimate& estimate : small)
+      estimate.rows = own.front().rows / 3;
+    MultigridPreconditioner mismatched(prolongations);
+    mismatched.seed_smoother_estimates(small);
+    ASSERT_TRUE(mismatched.setup(system.A));
+    for (std::size_t k = 0; k < seeds.size(); ++k) {
+      if (own[k].rows > 2 * small[k].rows) {
+        EXPECT_EQ(mismatched.smoother_estimates()[k].lambda, own[k].lambda);
+      }
+    }
+    // Seeds for another number of levels are not used either.
+    MultigridPreconditioner fewer(prolongations);
+    fewer.seed_smoother_estimates({seeds.front()});
+    ASSERT_TRUE(fewer.setup(system.A));
+    EXPECT_EQ(fewer.smoother_estimates().front().lambda, own.front().lambda);
+  }
+  MultigridPreconditioner cycle({});
+  EXPECT_THROW(cycle.seed_smoother_estimates({{10, 0.0}}), std::invalid_argument);
+  EXPECT_THROW(cycle.seed_smoother_estimates({{10, std::nan("")}}), std::invalid_argument);
+  EXPECT_THROW(cycle.seed_smoother_estimates({{0, 2.0}}), std::invalid_argument);
 }
 
 // Deterministic PCG iteration counts (relative residual 10⁻¹⁰) of uniform cuts at levels 1–3:

@@ -28,6 +28,10 @@ struct SpdSolver::Cycle {
   virtual void widen_smoother_intervals() = 0;
   virtual double setup_seconds() const = 0;
   virtual int num_levels() const = 0;
+  /// MultigridPreconditioner::smoother_estimates and seed_smoother_estimates, where the cycle's
+  /// levels are the tree's (the algebraic cycle's are rebuilt with their system).
+  virtual std::vector<SmootherEstimate> smoother_estimates() const { return {}; }
+  virtual void seed_smoother_estimates(std::vector<SmootherEstimate> /*estimates*/) {}
 };
 
 namespace {
@@ -46,6 +50,12 @@ struct TreeCycle final : SpdSolver::Cycle {
   void widen_smoother_intervals() override { preconditioner.widen_smoother_intervals(); }
   double setup_seconds() const override { return preconditioner.setup_seconds(); }
   int num_levels() const override { return preconditioner.num_levels(); }
+  std::vector<SmootherEstimate> smoother_estimates() const override {
+    return preconditioner.smoother_estimates();
+  }
+  void seed_smoother_estimates(std::vector<SmootherEstimate> estimates) override {
+    preconditioner.seed_smoother_estimates(std::move(estimates));
+  }
 };
 
 /// BoomerAMG's coarse spaces with strata's cycle: the interpolations come from hypre (once per
@@ -157,6 +167,16 @@ void SpdSolver::use_algebraic_multigrid() {
 
 int SpdSolver::multigrid_levels() const {
   return m_multigrid != nullptr ? m_multigrid->num_levels() : 0;
+}
+
+std::vector<SmootherEstimate> SpdSolver::smoother_estimates() const {
+  if (m_multigrid == nullptr || m_multigrid_setups == 0) return {};
+  return m_multigrid->smoother_estimates();
+}
+
+void SpdSolver::seed_smoother_estimates(std::vector<SmootherEstimate> estimates) {
+  if (m_multigrid != nullptr && !estimates.empty())
+    m_multigrid->seed_smoother_estimates(std::move(estimates));
 }
 
 bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {

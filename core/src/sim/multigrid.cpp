@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
@@ -407,16 +408,34 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
 
 namespace {
 
-/// max_j Σ_i |A_ij| / A_jj: the row-sum (Gershgorin) bound of the spectrum of D⁻¹A.
-double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal) {
-  double bound = 0.0;
-  for (Index j = 0; j < A.outerSize(); ++j) {
-    double sum = 0.0;
-    for (SparseMatrixd::InnerIterator it(A, j); it; ++it)
-      sum += std::abs(it.value());
-    bound = std::max(bound, sum * inverse_diagonal[j]);
-  }
-  return bound;
+/// max_j Σ_i |A_ij| / A_jj: the row-sum (Gershgorin) bound of the spectrum of D⁻¹A (A symmetric,
+/// both triangles stored), over ranges of columns in parallel (a maximum: the same at any thread
+/// count). With `inverse_diagonal_out`, D⁻¹ is written there from the same pass (zero where a
+/// diagonal entry is not positive) and used; otherwise `inverse_diagonal` is read.
+double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal,
+                     VectorXd* inverse_diagonal_out = nullptr) {
+  if (inverse_diagonal_out != nullptr) inverse_diagonal_out->resize(A.cols());
+  return tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, A.outerSize(), 2048), 0.0,
+      [&](const tbb::blocked_range<Index>& range, double bound) {
+        for (Index j = range.begin(); j != range.end(); ++j) {
+          double sum = 0.0, diagonal = 0.0;
+          for (SparseMatrixd::InnerIterator it(A, j); it; ++it) {
+            sum += std::abs(it.value());
+            if (it.index() == j) diagonal = it.value();
+          }
+          double inverse = 0.0;
+          if (inverse_diagonal_out != nullptr) {
+            inverse = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
+            (*inverse_diagonal_out)[j] = inverse;
+          } else {
+            inverse = inverse_diagonal[j];
+          }
+          bound = std::max(bound, sum * inverse);
+        }
+        return bound;
+      },
+      [](double a, double b) { return std::max(a, b); });
 }
 
 }  // namespace
@@ -428,6 +447,7 @@ struct MultigridPreconditioner::Level {
   VectorXd inverse_diagonal;
   double lambda_min = 0.0;  ///< Chebyshev interval of D⁻¹A
   double lambda_max = 0.0;
+  double lambda_estimate = 0.0;            ///< the Lanczos estimate λ̂ (measured or seeded)
   mutable VectorXd r, d, d_next, z, x, b;  ///< scratch of the cycle
 };
 
@@ -489,8 +509,17 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     m_levels[0]->blocks.keep_single_precision(false);
     m_levels[0]->blocks.assign(A);
   }
-  for (int k = 1; k <= L; ++k)
-    setup_smoother(*m_levels[k]);
+  const bool seeded = static_cast<int>(m_seed.size()) == L;
+  for (int k = 1; k <= L; ++k) {
+    double estimate = 0.0;
+    if (seeded) {
+      const SmootherEstimate& seed = m_seed[k - 1];
+      const Index rows = m_levels[k]->A->rows();
+      if (2 * seed.rows >= rows && seed.rows <= 2 * rows) estimate = seed.lambda;
+    }
+    setup_smoother(*m_levels[k], estimate);
+  }
+  m_seed.clear();
   m_sizes.clear();
   for (const auto& level : m_levels)
     m_sizes.push_back(level->A->rows());
@@ -523,14 +552,30 @@ void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {
   });
 }
 
-void MultigridPreconditioner::setup_smoother(Level& level) {
+std::vector<SmootherEstimate> MultigridPreconditioner::smoother_estimates() const {
+  std::vector<SmootherEstimate> estimates;
+  if (m_sizes.empty()) return estimates;
+  for (int k = 1; k < num_levels(); ++k)
+    estimates.push_back({m_sizes[k], m_levels[k]->lambda_estimate});
+  return estimates;
+}
+
+void MultigridPreconditioner::seed_smoother_estimates(std::vector<SmootherEstimate> estimates) {
+  for (const SmootherEstimate& estimate : estimates)
+    if (!(estimate.lambda > 0.0) || !std::isfinite(estimate.lambda) || estimate.rows <= 0)
+      throw std::invalid_argument(
+          "MultigridPreconditioner::seed_smoother_estimates: an estimate is not positive");
+  m_seed = std::move(estimates);
+}
+
+void MultigridPreconditioner::setup_smoother(Level& level, double seeded) {
   const SparseMatrixd& A = *level.A;
-  const Index n = A.rows();
-  level.inverse_diagonal.resize(n);
-  for (Index i = 0; i < n; ++i) {
-    const double d = A.coeff(i, i);
-    level.inverse_diagonal[i] = d > 0.0 ? 1.0 / d : 0.0;
+  const double gershgorin = row_sum_bound(A, level.inverse_diagonal, &level.inverse_diagonal);
+  if (seeded > 0.0) {
+    set_smoother_interval(level, seeded, gershgorin);
+    return;
   }
+  const Index n = A.rows();
   // Largest eigenvalue of D⁻¹A by Lanczos through Jacobi-preconditioned CG (faster to converge
   // at the spectrum's ends than power iteration), from a fixed pseudo-random right-hand side.
   std::mt19937 random(12345u);
@@ -568,10 +613,15 @@ void MultigridPreconditioner::setup_smoother(Level& level) {
                  .eigenvalues()
                  .maxCoeff();
   }
+  set_smoother_interval(level, lambda, gershgorin);
+}
+
+void MultigridPreconditioner::set_smoother_interval(Level& level, double lambda,
+                                                    double gershgorin) const {
   // A Ritz value bounds λ_max from below; the Chebyshev polynomial stays below 1 in magnitude
   // up to 2θ = upper + lower, so the upper end gets a margin, capped by the row-sum (Gershgorin)
   // bound of D⁻¹A, which holds for any matrix.
-  const double gershgorin = row_sum_bound(A, level.inverse_diagonal);
+  level.lambda_estimate = lambda;
   level.lambda_max = std::min(1.2 * lambda, std::max(gershgorin, lambda));
   level.lambda_min = m_options.chebyshev_lower * lambda;
 }

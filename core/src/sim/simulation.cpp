@@ -128,6 +128,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                        std::to_string(num_dof_vertices) + " DOF vertices");
     options.nested_spaces.check();
     m_nested = std::move(options.nested_spaces);
+    m_smoother_seed = std::move(options.smoother_estimates);
   }
   if (m_material.plasticity) {
     m_plastic = PlasticState::identity(m_mesh.tets.rows());
@@ -197,6 +198,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .ground = m_ground ? &*m_ground : nullptr,
                              .ground_stiffness = m_ground_stiffness,
                              .nested_spaces = m_nested.empty() ? nullptr : &m_nested,
+                             .smoother_estimates = &m_smoother_seed,
                              .timed_forces = &m_timed,
                              .springs = m_springs.get(),
                              .obstacles = &m_obstacles,
@@ -599,6 +601,11 @@ void Simulation::record_newton(const NewtonResult& result) {
   if (result.residual_target > 0.0)
     m_newton.max_residual_ratio =
         std::max(m_newton.max_residual_ratio, result.residual / result.residual_target);
+}
+
+std::vector<SmootherEstimate> Simulation::smoother_estimates() const {
+  const SpdSolver* solver = m_stepper->linear_solver();
+  return solver != nullptr ? solver->smoother_estimates() : std::vector<SmootherEstimate>{};
 }
 
 SimulationCounters Simulation::counters() const {

@@ -289,9 +289,9 @@ class AdaptiveSimulation final : public SimulationRun {
   /// Flattens the cut (m_constrained) and maps the finest-level loads onto it (m_load_traction);
   /// returns the options of a Simulation on it that starts at `first_step`.
   SimulationOptions flatten(long first_step);
-  /// flatten() and a new Simulation on the cut; m_mesh_external follows.
-  /// Flattens the cut and builds its Simulation; returns the flattening's seconds.
-  double rebuild(long first_step);
+  /// flatten() and a new Simulation on the cut, its multigrid seeded with `smoother_estimates`
+  /// (SimulationOptions); m_mesh_external follows. Returns the flattening's seconds.
+  double rebuild(long first_step, std::vector<SmootherEstimate> smoother_estimates = {});
   /// *m_simulation; throws std::logic_error when a failed cut change left none.
   const Simulation& live() const;
   /// One decision and its cut change; a positive `calibration_target` refines against it instead

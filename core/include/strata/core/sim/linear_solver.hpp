@@ -89,6 +89,12 @@ class SpdSolver {
   double multigrid_setup_seconds() const { return m_multigrid_setup_seconds; }
   /// Levels of the multigrid hierarchy (0 unless multigrid).
   int multigrid_levels() const;
+  /// The smoothers' Lanczos estimates of the tree's multigrid as of its last setup (empty for
+  /// other solvers or before a setup), and the same passed to the next setup of the tree's
+  /// multigrid built by use_nested_spaces() (MultigridPreconditioner::seed_smoother_estimates;
+  /// ignored by other solvers).
+  std::vector<SmootherEstimate> smoother_estimates() const;
+  void seed_smoother_estimates(std::vector<SmootherEstimate> estimates);
   /// Flops of a Cholesky factorisation per non-zero of A, from the last symbolic analysis (0
   /// before any): the cost `automatic` compares with kAlgebraicMultigridMinFill.
   double factor_flops_per_nonzero() const { return m_factor_flops_per_nonzero; }

@@ -87,6 +87,13 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
 /// Whether galerkin_product(A, P) goes by blocks.
 bool galerkin_product_by_blocks(const SparseMatrixd& A, const SparseMatrixd& P);
 
+/// The Lanczos estimate λ̂ of λ_max(D⁻¹A) on one smoothed level and that level's unknowns: what a
+/// hierarchy on a nearby system (the previous cut of an adaptive run) can pass on to the next.
+struct SmootherEstimate {
+  Index rows = 0;
+  double lambda = 0.0;
+};
+
 class MultigridPreconditioner {
  public:
   using Options = MultigridOptions;
@@ -125,6 +132,17 @@ class MultigridPreconditioner {
   /// definite, at slower smoothing, until the next setup().
   void widen_smoother_intervals();
 
+  /// The Lanczos estimates of the smoothed levels (1 … finest) as of the last setup(), whether
+  /// measured there or seeded.
+  std::vector<SmootherEstimate> smoother_estimates() const;
+  /// The next setup() takes these as the Lanczos estimates of its smoothed levels (level 1 first)
+  /// instead of running Lanczos, level by level where the counts match and a level's unknowns are
+  /// within a factor 2 of the estimate's; other levels run Lanczos. λ_max(D⁻¹A) of a level follows
+  /// its elements' shapes and materials, which a local change of the system leaves the same; the
+  /// interval's margin and the fallbacks of an estimate that misses the top of the spectrum
+  /// (widen_smoother_intervals, a new setup) are those of a measured one. Used by one setup().
+  void seed_smoother_estimates(std::vector<SmootherEstimate> estimates);
+
   int num_levels() const { return static_cast<int>(m_levels.size()); }
   /// The Chebyshev interval [λ_min, λ_max] of level k's smoother (D⁻¹A; k ≥ 1) and whether its
   /// products use the 3 × 3-block copy, as of the last setup (for tests and diagnostics).
@@ -139,7 +157,10 @@ class MultigridPreconditioner {
  private:
   struct Level;
   struct Coarse;
-  void setup_smoother(Level& level);
+  /// D⁻¹, the Lanczos estimate (or `seeded`, when positive) and the Chebyshev interval.
+  void setup_smoother(Level& level, double seeded);
+  /// [chebyshev_lower · λ̂, min(1.2 λ̂, max(row-sum bound, λ̂))] for the estimate λ̂.
+  void set_smoother_interval(Level& level, double lambda, double gershgorin) const;
   void cycle(int k, const VectorXd& b, VectorXd& x) const;
   void smooth(const Level& level, const VectorXd& b, VectorXd& x, bool zero_start) const;
   static double multiply(const Level& level, ConstRef<VectorXd> x, VectorXd& y,
@@ -151,7 +172,8 @@ class MultigridPreconditioner {
   std::vector<Eigen::SparseMatrix<double, Eigen::RowMajor, int>> m_prolongation_rows;
   std::vector<std::unique_ptr<Level>> m_levels;  ///< coarsest first; finest last
   std::unique_ptr<Coarse> m_coarse;
-  std::vector<Index> m_sizes;  ///< unknowns per level at the last setup
+  std::vector<Index> m_sizes;            ///< unknowns per level at the last setup
+  std::vector<SmootherEstimate> m_seed;  ///< for the next setup (seed_smoother_estimates)
   double m_setup_seconds = 0.0;
 };
 

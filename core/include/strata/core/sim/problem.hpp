@@ -47,6 +47,9 @@ struct Problem {
   /// Optional coarser spaces below the DOF vertices (the refinement tree's levels) for the
   /// multigrid linear solver; null: none.
   const NestedSpaces* nested_spaces = nullptr;
+  /// Smoother estimates from a hierarchy on a nearby system for the first multigrid setup on
+  /// nested_spaces (MultigridPreconditioner::seed_smoother_estimates); null or empty: none.
+  const std::vector<SmootherEstimate>* smoother_estimates = nullptr;
   /// Loads that follow their own amplitude s_k(t) (3·#Q each); null or empty: none.
   const std::vector<TimedForces>* timed_forces = nullptr;
   /// Surface springs on the DOF vertices (meshes without an embedding); null: none.

@@ -85,6 +85,9 @@ struct SimulationOptions {
   /// Coarser spaces below the DOF vertices for the multigrid linear solver (the refinement tree's
   /// levels, hierarchy/cut_levels.hpp); empty: none.
   NestedSpaces nested_spaces;
+  /// The smoother estimates of a multigrid hierarchy on a nearby system (the previous cut:
+  /// Simulation::smoother_estimates) for the first setup on `nested_spaces`; empty: measured.
+  std::vector<SmootherEstimate> smoother_estimates;
   /// Plastic state per mesh tet to start from (material with plasticity only); empty: virgin
   /// material (Fₚ = I, ε̄ₚ = 0).
   PlasticState plastic_state;
@@ -202,6 +205,9 @@ class Simulation final : public SimulationRun {
   /// −f_ext(t)ᵀ(x − X).
   double external_potential_energy() const;
   SimulationCounters counters() const override;
+  /// The smoother estimates of the tree multigrid's last setup (empty without one), for a
+  /// Simulation built next on a nearby system (SimulationOptions::smoother_estimates).
+  std::vector<SmootherEstimate> smoother_estimates() const;
   /// A plain run is its own current simulation.
   const Simulation& current() const override { return *this; }
 
@@ -299,6 +305,7 @@ class Simulation final : public SimulationRun {
   mutable double m_stable_dt = 0.0;
   DivergenceLimits m_limits;
   NestedSpaces m_nested;
+  std::vector<SmootherEstimate> m_smoother_seed;  ///< SimulationOptions::smoother_estimates
   std::unique_ptr<Problem> m_system;
   const StepperTraits* m_stepper_traits = nullptr;
   std::unique_ptr<TimeStepper> m_stepper;
