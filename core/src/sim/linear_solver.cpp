@@ -28,10 +28,11 @@ struct SpdSolver::Cycle {
   virtual void widen_smoother_intervals() = 0;
   virtual double setup_seconds() const = 0;
   virtual int num_levels() const = 0;
-  /// MultigridPreconditioner::smoother_estimates and seed_smoother_estimates, where the cycle's
-  /// levels are the tree's (the algebraic cycle's are rebuilt with their system).
+  /// MultigridPreconditioner::smoother_estimates, seed_smoother_estimates and seeded_setup, where
+  /// the cycle's levels are the tree's (the algebraic cycle's are rebuilt with their system).
   virtual std::vector<SmootherEstimate> smoother_estimates() const { return {}; }
   virtual void seed_smoother_estimates(std::vector<SmootherEstimate> /*estimates*/) {}
+  virtual bool seeded_setup() const { return false; }
 };
 
 namespace {
@@ -56,6 +57,7 @@ struct TreeCycle final : SpdSolver::Cycle {
   void seed_smoother_estimates(std::vector<SmootherEstimate> estimates) override {
     preconditioner.seed_smoother_estimates(std::move(estimates));
   }
+  bool seeded_setup() const override { return preconditioner.seeded_setup(); }
 };
 
 /// BoomerAMG's coarse spaces with strata's cycle: the interpolations come from hypre (once per
@@ -132,7 +134,8 @@ SpdSolver::SpdSolver(LinearSolverKind kind)
 
 SpdSolver::~SpdSolver() = default;
 
-void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs) {
+void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs,
+                                  std::vector<SmootherEstimate> smoother_estimates) {
   const LinearSolverKind requested = m_requested;
   m_rows = m_nonzeros = m_multigrid_rows = m_multigrid_nonzeros = -1;
   m_has_factor = false;
@@ -149,6 +152,8 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
     m_kind = LinearSolverKind::multigrid;
     m_multigrid =
         std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs), m_cycle_options);
+    if (!smoother_estimates.empty())
+      m_multigrid->seed_smoother_estimates(std::move(smoother_estimates));
   } else if (requested == LinearSolverKind::amg) {
     use_algebraic_multigrid();
   } else if (requested == LinearSolverKind::automatic) {
@@ -172,11 +177,6 @@ int SpdSolver::multigrid_levels() const {
 std::vector<SmootherEstimate> SpdSolver::smoother_estimates() const {
   if (m_multigrid == nullptr || m_multigrid_setups == 0) return {};
   return m_multigrid->smoother_estimates();
-}
-
-void SpdSolver::seed_smoother_estimates(std::vector<SmootherEstimate> estimates) {
-  if (m_multigrid != nullptr && !estimates.empty())
-    m_multigrid->seed_smoother_estimates(std::move(estimates));
 }
 
 bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
@@ -309,8 +309,9 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
     return result == -3 ? -1 : result;
   };
   int iterations = pcg();
-  if (iterations == -1 && !fresh) {
-    // Stale coarse levels: set up on this matrix and try once more.
+  if (iterations == -1 && (!fresh || m_multigrid->seeded_setup())) {
+    // Stale coarse levels, or smoothers on a previous system's estimates: set up on this matrix,
+    // measuring the estimates, and try once more.
     if (!setup()) return direct();
     iterations = pcg();
   }

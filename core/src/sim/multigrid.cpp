@@ -408,34 +408,54 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
 
 namespace {
 
-/// max_j Σ_i |A_ij| / A_jj: the row-sum (Gershgorin) bound of the spectrum of D⁻¹A (A symmetric,
-/// both triangles stored), over ranges of columns in parallel (a maximum: the same at any thread
-/// count). With `inverse_diagonal_out`, D⁻¹ is written there from the same pass (zero where a
-/// diagonal entry is not positive) and used; otherwise `inverse_diagonal` is read.
-double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal,
-                     VectorXd* inverse_diagonal_out = nullptr) {
+/// max_j Σ_i |A_ij| / A_jj over columns j in [begin, end) (A symmetric, both triangles stored),
+/// D⁻¹ from `inverse_diagonal`, or written into `*inverse_diagonal_out` from the same pass when it
+/// is given (zero where a diagonal entry is missing or not positive).
+double column_row_sums(const SparseMatrixd& A, Index begin, Index end,
+                       const VectorXd& inverse_diagonal, VectorXd* inverse_diagonal_out) {
+  double bound = 0.0;
+  for (Index j = begin; j != end; ++j) {
+    double sum = 0.0, diagonal = 0.0;
+    for (SparseMatrixd::InnerIterator it(A, j); it; ++it) {
+      sum += std::abs(it.value());
+      if (it.index() == j) diagonal = it.value();
+    }
+    double inverse = 0.0;
+    if (inverse_diagonal_out != nullptr) {
+      inverse = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
+      (*inverse_diagonal_out)[j] = inverse;
+    } else {
+      inverse = inverse_diagonal[j];
+    }
+    bound = std::max(bound, sum * inverse);
+  }
+  return bound;
+}
+
+/// The row-sum (Gershgorin) bound of the spectrum of D⁻¹A, over ranges of columns in parallel (a
+/// maximum: the same at any thread count). With `inverse_diagonal_out`, D⁻¹ is written there in
+/// the same pass; otherwise `inverse_diagonal` is read.
+double parallel_row_sums(const SparseMatrixd& A, const VectorXd& inverse_diagonal,
+                         VectorXd* inverse_diagonal_out) {
   if (inverse_diagonal_out != nullptr) inverse_diagonal_out->resize(A.cols());
   return tbb::parallel_reduce(
       tbb::blocked_range<Index>(0, A.outerSize(), 2048), 0.0,
       [&](const tbb::blocked_range<Index>& range, double bound) {
-        for (Index j = range.begin(); j != range.end(); ++j) {
-          double sum = 0.0, diagonal = 0.0;
-          for (SparseMatrixd::InnerIterator it(A, j); it; ++it) {
-            sum += std::abs(it.value());
-            if (it.index() == j) diagonal = it.value();
-          }
-          double inverse = 0.0;
-          if (inverse_diagonal_out != nullptr) {
-            inverse = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
-            (*inverse_diagonal_out)[j] = inverse;
-          } else {
-            inverse = inverse_diagonal[j];
-          }
-          bound = std::max(bound, sum * inverse);
-        }
-        return bound;
+        return std::max(bound, column_row_sums(A, range.begin(), range.end(), inverse_diagonal,
+                                               inverse_diagonal_out));
       },
       [](double a, double b) { return std::max(a, b); });
+}
+
+/// max_j Σ_i |A_ij| / A_jj for the given D⁻¹.
+double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal) {
+  return parallel_row_sums(A, inverse_diagonal, nullptr);
+}
+
+/// D⁻¹ of A into `inverse_diagonal` and the row-sum bound of D⁻¹A, from one pass.
+double inverse_diagonal_and_row_sum_bound(const SparseMatrixd& A, VectorXd& inverse_diagonal) {
+  static const VectorXd kUnused;
+  return parallel_row_sums(A, kUnused, &inverse_diagonal);
 }
 
 }  // namespace
@@ -448,6 +468,7 @@ struct MultigridPreconditioner::Level {
   double lambda_min = 0.0;  ///< Chebyshev interval of D⁻¹A
   double lambda_max = 0.0;
   double lambda_estimate = 0.0;            ///< the Lanczos estimate λ̂ (measured or seeded)
+  Index estimate_rows = 0;                 ///< the unknowns of the level λ̂ was measured on
   mutable VectorXd r, d, d_next, z, x, b;  ///< scratch of the cycle
 };
 
@@ -483,6 +504,9 @@ std::vector<Index> MultigridPreconditioner::level_sizes() const {
 
 bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   const auto start = std::chrono::steady_clock::now();
+  // A seed serves this setup, whatever its outcome.
+  const std::vector<SmootherEstimate> pending_seed = std::move(m_seed);
+  m_seed.clear();
   const int L = num_levels() - 1;
   if (!m_prolongations.empty() && m_prolongations.back().rows() != A.rows())
     throw std::invalid_argument("MultigridPreconditioner::setup: matrix has " +
@@ -509,17 +533,19 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     m_levels[0]->blocks.keep_single_precision(false);
     m_levels[0]->blocks.assign(A);
   }
-  const bool seeded = static_cast<int>(m_seed.size()) == L;
+  m_seeded_setup = false;
   for (int k = 1; k <= L; ++k) {
-    double estimate = 0.0;
-    if (seeded) {
-      const SmootherEstimate& seed = m_seed[k - 1];
+    SmootherEstimate seed;
+    if (static_cast<int>(pending_seed.size()) == L) {
       const Index rows = m_levels[k]->A->rows();
-      if (2 * seed.rows >= rows && seed.rows <= 2 * rows) estimate = seed.lambda;
+      const SmootherEstimate& offered = pending_seed[k - 1];
+      if (offered.lambda > 0.0 && std::isfinite(offered.lambda) && offered.rows > 0 &&
+          2 * offered.rows >= rows && offered.rows <= 2 * rows)
+        seed = offered;
     }
-    setup_smoother(*m_levels[k], estimate);
+    m_seeded_setup = m_seeded_setup || seed.lambda > 0.0;
+    setup_smoother(*m_levels[k], seed);
   }
-  m_seed.clear();
   m_sizes.clear();
   for (const auto& level : m_levels)
     m_sizes.push_back(level->A->rows());
@@ -556,23 +582,21 @@ std::vector<SmootherEstimate> MultigridPreconditioner::smoother_estimates() cons
   std::vector<SmootherEstimate> estimates;
   if (m_sizes.empty()) return estimates;
   for (int k = 1; k < num_levels(); ++k)
-    estimates.push_back({m_sizes[k], m_levels[k]->lambda_estimate});
+    estimates.push_back({m_levels[k]->estimate_rows, m_levels[k]->lambda_estimate});
   return estimates;
 }
 
 void MultigridPreconditioner::seed_smoother_estimates(std::vector<SmootherEstimate> estimates) {
-  for (const SmootherEstimate& estimate : estimates)
-    if (!(estimate.lambda > 0.0) || !std::isfinite(estimate.lambda) || estimate.rows <= 0)
-      throw std::invalid_argument(
-          "MultigridPreconditioner::seed_smoother_estimates: an estimate is not positive");
   m_seed = std::move(estimates);
 }
 
-void MultigridPreconditioner::setup_smoother(Level& level, double seeded) {
+void MultigridPreconditioner::setup_smoother(Level& level, const SmootherEstimate& seed) {
   const SparseMatrixd& A = *level.A;
-  const double gershgorin = row_sum_bound(A, level.inverse_diagonal, &level.inverse_diagonal);
-  if (seeded > 0.0) {
-    set_smoother_interval(level, seeded, gershgorin);
+  const double gershgorin = inverse_diagonal_and_row_sum_bound(A, level.inverse_diagonal);
+  if (seed.lambda > 0.0) {
+    // Above the row-sum bound an estimate is certainly too high for this operator.
+    set_smoother_interval(level, std::min(seed.lambda, gershgorin), gershgorin);
+    level.estimate_rows = seed.rows;
     return;
   }
   const Index n = A.rows();
@@ -614,6 +638,7 @@ void MultigridPreconditioner::setup_smoother(Level& level, double seeded) {
                  .maxCoeff();
   }
   set_smoother_interval(level, lambda, gershgorin);
+  level.estimate_rows = n;
 }
 
 void MultigridPreconditioner::set_smoother_interval(Level& level, double lambda,

@@ -63,7 +63,12 @@ class SpdSolver {
   /// `multigrid` is CHOLMOD, `automatic` chooses the same way, and algebraic multigrid takes the
   /// systems' rows as whole vertices (x, y, z); a system whose row count is not a multiple of 3
   /// then goes to CHOLMOD.
-  void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs);
+  /// `smoother_estimates` (from a previous hierarchy: smoother_estimates()) seed the first setup
+  /// of the tree's multigrid (MultigridPreconditioner::seed_smoother_estimates); should PCG not
+  /// converge on that hierarchy, it is set up again with measured estimates before CHOLMOD is
+  /// asked.
+  void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs,
+                         std::vector<SmootherEstimate> smoother_estimates = {});
 
   /// Relative residual ‖b − A x‖ / ‖b‖ at which the iterative paths (CG on a previous factor,
   /// multigrid-PCG) stop; default 10⁻¹⁰. Newton sets it per solve (inexact Newton).
@@ -90,11 +95,8 @@ class SpdSolver {
   /// Levels of the multigrid hierarchy (0 unless multigrid).
   int multigrid_levels() const;
   /// The smoothers' Lanczos estimates of the tree's multigrid as of its last setup (empty for
-  /// other solvers or before a setup), and the same passed to the next setup of the tree's
-  /// multigrid built by use_nested_spaces() (MultigridPreconditioner::seed_smoother_estimates;
-  /// ignored by other solvers).
+  /// other solvers or before a setup).
   std::vector<SmootherEstimate> smoother_estimates() const;
-  void seed_smoother_estimates(std::vector<SmootherEstimate> estimates);
   /// Flops of a Cholesky factorisation per non-zero of A, from the last symbolic analysis (0
   /// before any): the cost `automatic` compares with kAlgebraicMultigridMinFill.
   double factor_flops_per_nonzero() const { return m_factor_flops_per_nonzero; }

@@ -132,16 +132,20 @@ class MultigridPreconditioner {
   /// definite, at slower smoothing, until the next setup().
   void widen_smoother_intervals();
 
-  /// The Lanczos estimates of the smoothed levels (1 … finest) as of the last setup(), whether
-  /// measured there or seeded.
+  /// The Lanczos estimates of the smoothed levels (1 … finest) as of the last setup(), each with
+  /// the unknowns of the level it was measured on (for a seeded level, the seed's).
   std::vector<SmootherEstimate> smoother_estimates() const;
-  /// The next setup() takes these as the Lanczos estimates of its smoothed levels (level 1 first)
-  /// instead of running Lanczos, level by level where the counts match and a level's unknowns are
-  /// within a factor 2 of the estimate's; other levels run Lanczos. λ_max(D⁻¹A) of a level follows
-  /// its elements' shapes and materials, which a local change of the system leaves the same; the
-  /// interval's margin and the fallbacks of an estimate that misses the top of the spectrum
-  /// (widen_smoother_intervals, a new setup) are those of a measured one. Used by one setup().
+  /// The next setup() — whether it succeeds or not — takes these as the Lanczos estimates of its
+  /// smoothed levels (level 1 first) instead of running Lanczos, when their number is the number
+  /// of smoothed levels, on each level whose unknowns are within a factor 2 of the estimate's
+  /// (levels are matched by position; the tree's cuts number theirs alike) and whose estimate is
+  /// positive and finite, at most the level's row-sum bound; the other levels run Lanczos.
+  /// λ_max(D⁻¹A) of a level follows its elements' shapes and material, which a local change of
+  /// the system leaves as they were; an estimate that misses the top of the new spectrum leaves
+  /// the V-cycle indefinite, which widen_smoother_intervals repairs, as for a measured one.
   void seed_smoother_estimates(std::vector<SmootherEstimate> estimates);
+  /// Whether the last setup() took a seeded estimate on any level.
+  bool seeded_setup() const { return m_seeded_setup; }
 
   int num_levels() const { return static_cast<int>(m_levels.size()); }
   /// The Chebyshev interval [λ_min, λ_max] of level k's smoother (D⁻¹A; k ≥ 1) and whether its
@@ -157,8 +161,8 @@ class MultigridPreconditioner {
  private:
   struct Level;
   struct Coarse;
-  /// D⁻¹, the Lanczos estimate (or `seeded`, when positive) and the Chebyshev interval.
-  void setup_smoother(Level& level, double seeded);
+  /// D⁻¹, the Lanczos estimate (or the seed's, when it has one) and the Chebyshev interval.
+  void setup_smoother(Level& level, const SmootherEstimate& seed);
   /// [chebyshev_lower · λ̂, min(1.2 λ̂, max(row-sum bound, λ̂))] for the estimate λ̂.
   void set_smoother_interval(Level& level, double lambda, double gershgorin) const;
   void cycle(int k, const VectorXd& b, VectorXd& x) const;
@@ -174,6 +178,7 @@ class MultigridPreconditioner {
   std::unique_ptr<Coarse> m_coarse;
   std::vector<Index> m_sizes;            ///< unknowns per level at the last setup
   std::vector<SmootherEstimate> m_seed;  ///< for the next setup (seed_smoother_estimates)
+  bool m_seeded_setup = false;
   double m_setup_seconds = 0.0;
 };
 
