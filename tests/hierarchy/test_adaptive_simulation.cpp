@@ -239,17 +239,30 @@ TEST(AdaptiveSimulation, LocalisedLoadRefinesNearItAndApproachesFullResolution) 
   EXPECT_GT(adaptive_tets, coarse_tets);
 }
 
+/// Backward Euler on the pressed slab for 20 steps of 2 ms, adapting every 2 steps from
+/// `start_level` of 2 levels.
+struct ChangingSlabRun {
+  SolverSettings solver;
+  HierarchySettings hierarchy;
+};
+ChangingSlabRun changing_slab_run(int start_level,
+                                  LinearSolverKind linear_solver = SolverSettings().linear_solver) {
+  ChangingSlabRun run;
+  run.solver.integrator = Integrator::implicit_euler;
+  run.solver.linear_solver = linear_solver;
+  run.solver.dt = 2e-3;
+  run.solver.duration = 0.04;
+  run.hierarchy = hierarchy(2, HierarchyMode::adaptive, start_level);
+  run.hierarchy.adapt_every = 2;
+  run.hierarchy.criteria.min_steps_between_changes = 2;
+  return run;
+}
+
 TEST(AdaptiveSimulation, RefinementKeepsTheEnergyAndTheCutFollowsTheLoad) {
   const PressedSlab slab;
-  SolverSettings settings;
-  settings.integrator = Integrator::implicit_euler;
-  settings.dt = 2e-3;
-  settings.duration = 0.04;
-  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
-  h.adapt_every = 2;
-  h.criteria.min_steps_between_changes = 2;
-  AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
-                         Vector3d::Zero(), settings);
+  const ChangingSlabRun setup = changing_slab_run(0);
+  AdaptiveSimulation sim(slab.coarse, setup.hierarchy, rubber(), slab.fixed, slab.loads,
+                         std::nullopt, Vector3d::Zero(), setup.solver);
   run(sim);
   ASSERT_FALSE(sim.changes().empty());
   for (const CutChangeRecord& change : sim.changes()) {
@@ -301,18 +314,11 @@ TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
   // builds none.
   const PressedSlab slab;
   for (const LinearSolverKind solver : {LinearSolverKind::multigrid, LinearSolverKind::cholmod}) {
-    SolverSettings settings;
-    settings.integrator = Integrator::implicit_euler;
-    settings.linear_solver = solver;
-    settings.dt = 2e-3;
-    settings.duration = 0.04;
     // From level 1: the cuts have a coarse level of an eighth of their vertices (a space that
     // shrinks less is merged into the next, and a single level is solved by CHOLMOD).
-    HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 1);
-    h.adapt_every = 2;
-    h.criteria.min_steps_between_changes = 2;
-    AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
-                           Vector3d::Zero(), settings);
+    const ChangingSlabRun setup = changing_slab_run(1, solver);
+    AdaptiveSimulation sim(slab.coarse, setup.hierarchy, rubber(), slab.fixed, slab.loads,
+                           std::nullopt, Vector3d::Zero(), setup.solver);
     run(sim);
     ASSERT_GE(sim.changes().size(), 2u);
     long recorded = 0;
@@ -343,16 +349,9 @@ TEST(AdaptiveSimulation, ACutChangeSeedsTheNewCutsSmoothersWithThoseOfTheCutBefo
   // change left, level by level where the level's size stays within a factor 2
   // (MultigridPreconditioner::seed_smoother_estimates).
   const PressedSlab slab;
-  SolverSettings settings;
-  settings.integrator = Integrator::implicit_euler;
-  settings.linear_solver = LinearSolverKind::multigrid;
-  settings.dt = 2e-3;
-  settings.duration = 0.04;
-  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 1);
-  h.adapt_every = 2;
-  h.criteria.min_steps_between_changes = 2;
-  AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
-                         Vector3d::Zero(), settings);
+  const ChangingSlabRun setup = changing_slab_run(1, LinearSolverKind::multigrid);
+  AdaptiveSimulation sim(slab.coarse, setup.hierarchy, rubber(), slab.fixed, slab.loads,
+                         std::nullopt, Vector3d::Zero(), setup.solver);
   std::vector<SmootherEstimate> left;  // of the cut a change left, until the new cut's first setup
   int compared_levels = 0;
   while (!sim.finished()) {
