@@ -5,8 +5,10 @@ Runs a scene (which has a "hierarchy" key) once with hierarchy.mode=full — the
 when its outputs are present from the same command, scene file and strata binary — and once per
 configuration given with --run NAME:key=value,... The error of a run is the largest
 probe-displacement difference to the full run over every frame and probe, relative to the largest
-full-resolution probe displacement (the measure hierarchy.tolerance bounds). Prints one line per
-run and writes <out>/compare.json:
+full-resolution probe displacement (the measure hierarchy.tolerance bounds). An adaptive run's
+error is set against its tolerance: `within_tolerance`, beside the run's own `tolerance_met`,
+flags a run over its tolerance that reported it met. Prints one line per run (and the run's
+warnings) and writes <out>/compare.json:
 
   compare_to_full.py SCENE.json [--out DIR] [--strata PATH] [--field]
                      [--run adaptive:] [--run tight:tolerance=0.005] [--set key=value ...]
@@ -71,6 +73,7 @@ def run(args, name, settings, frames=False):
         sys.exit(f"compare_to_full: {name} failed ({result.returncode}): {result.stderr.strip()}")
     stats = json.load(open(stats_path))
     stats["measured_seconds"] = time.monotonic() - start
+    stats["warnings"] = [line.strip() for line in result.stderr.splitlines() if "warning" in line]
     with open(key_path, "w") as f:
         json.dump(key, f)
     return stats, folder
@@ -123,7 +126,12 @@ def main():
                  "speedup": full_stats["wall_seconds"] / stats["wall_seconds"],
                  "final_tets": stats["tets"], "max_tets": max(history) if history else None,
                  "estimated_error": h.get("estimated_error"),
-                 "redone_steps": h.get("redone_steps")}
+                 "redone_steps": h.get("redone_steps"),
+                 "warnings": stats.get("warnings", [])}
+        if h.get("mode") == "adaptive" and h.get("tolerance") is not None:
+            entry["tolerance"] = h["tolerance"]
+            entry["tolerance_met"] = h.get("tolerance_met")
+            entry["within_tolerance"] = entry["error"] <= h["tolerance"]
         if args.field:
             field = field_error.field_error(full_frames, run(args, name, settings, True)[1])
             entry["field_error"] = field["error"]
@@ -139,6 +147,13 @@ def main():
               f"({entry['speedup']:.2f}x faster than full), tets final {entry['final_tets']} "
               f"max {entry['max_tets']}, estimated {entry['estimated_error']}, "
               f"redone steps {entry['redone_steps']}")
+        if "tolerance" in entry:
+            verdict = "within" if entry["within_tolerance"] else "OVER"
+            reported = "met" if entry["tolerance_met"] else "not met"
+            print(f"{name}: {verdict} its tolerance {100 * entry['tolerance']:.2f} % "
+                  f"(the run reported it {reported})")
+        for line in entry["warnings"]:
+            print(f"{name}: {line}")
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "compare.json"), "w") as f:
         json.dump(report, f, indent=2)
