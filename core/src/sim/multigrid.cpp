@@ -234,26 +234,43 @@ std::optional<VertexBlocks> vertex_blocks(const SparseMatrixd& A) {
   const Index nv = A.cols() / 3;
   result.columns.outer.assign(nv + 1, 0);
   result.stride.resize(nv);
-  result.columns.rows.reserve(A.nonZeros() / 9);
-  result.columns.at.reserve(A.nonZeros() / 9);
-  for (Index b = 0; b < nv; ++b) {
-    const int first = outer[3 * b];
-    const int count = outer[3 * b + 1] - first;
-    if (count % 3 != 0) return std::nullopt;
-    for (int c = 1; c < 3; ++c)
-      if (outer[3 * b + c + 1] - outer[3 * b + c] != count ||
-          !std::equal(inner + first, inner + first + count, inner + outer[3 * b + c]))
-        return std::nullopt;
-    for (int k = 0; k < count; k += 3) {
-      const int row = inner[first + k];
-      if (row % 3 != 0 || inner[first + k + 1] != row + 1 || inner[first + k + 2] != row + 2)
-        return std::nullopt;
-      result.columns.rows.push_back(row / 3);
-      result.columns.at.push_back(first + k);
-    }
-    result.columns.outer[b + 1] = static_cast<int>(result.columns.rows.size());
-    result.stride[b] = count;
-  }
+  // Vertex columns in parallel: first checked and counted, then written at their offsets.
+  const bool whole = tbb::parallel_reduce(
+      tbb::blocked_range<Index>(0, nv, 1024), true,
+      [&](const tbb::blocked_range<Index>& range, bool ok) {
+        for (Index b = range.begin(); ok && b != range.end(); ++b) {
+          const int first = outer[3 * b];
+          const int count = outer[3 * b + 1] - first;
+          ok = count % 3 == 0;
+          for (int c = 1; ok && c < 3; ++c)
+            ok = outer[3 * b + c + 1] - outer[3 * b + c] == count &&
+                 std::equal(inner + first, inner + first + count, inner + outer[3 * b + c]);
+          for (int k = 0; ok && k < count; k += 3) {
+            const int row = inner[first + k];
+            ok = row % 3 == 0 && inner[first + k + 1] == row + 1 && inner[first + k + 2] == row + 2;
+          }
+          result.columns.outer[b + 1] = count / 3;
+          result.stride[b] = count;
+        }
+        return ok;
+      },
+      std::logical_and<bool>());
+  if (!whole) return std::nullopt;
+  for (Index b = 0; b < nv; ++b)
+    result.columns.outer[b + 1] += result.columns.outer[b];
+  result.columns.rows.resize(result.columns.outer[nv]);
+  result.columns.at.resize(result.columns.outer[nv]);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nv, 1024),
+                    [&](const tbb::blocked_range<Index>& range) {
+                      for (Index b = range.begin(); b != range.end(); ++b) {
+                        const int first = outer[3 * b];
+                        for (int e = result.columns.outer[b], k = 0;
+                             e < result.columns.outer[b + 1]; ++e, k += 3) {
+                          result.columns.rows[e] = inner[first + k] / 3;
+                          result.columns.at[e] = first + k;
+                        }
+                      }
+                    });
   return result;
 }
 
