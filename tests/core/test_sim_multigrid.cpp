@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "strata/core/common/parallel.hpp"
+#include "strata/core/sim/block_matrix.hpp"
 #include "strata/core/sim/multigrid.hpp"
 
 namespace strata {
@@ -129,6 +130,12 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
     const SparseMatrixd blocked = galerkin_product(A, P);
     const SparseMatrixd scalar = scalar_galerkin_product(A, P);
     EXPECT_TRUE(same_bits(blocked, scalar)) << nv;
+    // From A's block copy (the values nine by nine), the same bits; with P not by vertices, or
+    // no copy, the scalar product's.
+    BlockSymmetricMatrix copy;
+    ASSERT_TRUE(copy.assign(A));
+    EXPECT_TRUE(same_bits(galerkin_product(A, copy, P), scalar)) << nv;
+    EXPECT_TRUE(same_bits(galerkin_product(A, BlockSymmetricMatrix(), P), scalar)) << nv;
     const SparseMatrixd expected = SparseMatrixd(P.transpose()) * (A * P);
     EXPECT_LE((Eigen::MatrixXd(blocked) - Eigen::MatrixXd(expected)).cwiseAbs().maxCoeff(),
               1e-12 * Eigen::MatrixXd(expected).cwiseAbs().maxCoeff());
@@ -157,6 +164,8 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
     P_uneven.valuePtr()[P_uneven.outerIndexPtr()[1]] *= 1.5;  // column 1: component y of vertex 0
     EXPECT_FALSE(galerkin_product_by_blocks(A, P_uneven));
     EXPECT_TRUE(same_bits(galerkin_product(A, P_uneven), scalar_galerkin_product(A, P_uneven)));
+    EXPECT_TRUE(
+        same_bits(galerkin_product(A, copy, P_uneven), scalar_galerkin_product(A, P_uneven)));
     SparseMatrixd A_partial = A;  // entries (y of a, z of b) of off-diagonal blocks removed
     A_partial.prune([](Index row, Index col, double) {
       return !(row / 3 != col / 3 && row % 3 == 1 && col % 3 == 2);
@@ -167,6 +176,10 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
     A_zero.valuePtr()[A_zero.outerIndexPtr()[4] + 1] = 0.0;  // stored, not removed
     EXPECT_TRUE(galerkin_product_by_blocks(A_zero, P));
     EXPECT_TRUE(same_bits(galerkin_product(A_zero, P), scalar_galerkin_product(A_zero, P)));
+    BlockSymmetricMatrix zero_copy;
+    ASSERT_TRUE(zero_copy.assign(A_zero));
+    EXPECT_TRUE(
+        same_bits(galerkin_product(A_zero, zero_copy, P), scalar_galerkin_product(A_zero, P)));
     EXPECT_FALSE(galerkin_product_by_blocks(A, kron3(Pv, Eigen::Matrix3d::Identity())));  // zeros
     const SparseMatrixd C = galerkin_product(A_dropped, P_dropped);
     const SparseMatrixd expected_dropped =

@@ -275,14 +275,16 @@ std::optional<VertexBlocks> vertex_blocks(const SparseMatrixd& A) {
 }
 
 /// PᵀAP by 3 × 3 blocks (P = P_v ⊗ I₃, A by blocks): the same products added in the same order
-/// as the scalar product below, entry by entry, so the result is bit for bit the same.
-SparseMatrixd blocked_galerkin_product(const SparseMatrixd& A, const VertexBlocks& blocks,
-                                       const SparseMatrixd& P, const VertexColumns& Pv) {
+/// as the scalar product below, entry by entry, so the result is bit for bit the same. A's blocks
+/// are given by block column (`outer`, `block_rows`: its nv block columns) and
+/// `entry(b, e, r, c)`, the value (r, c) of block e of column b.
+template <typename Entry>
+SparseMatrixd blocked_galerkin_product(Index nv, const int* outer, const int* block_rows,
+                                       const Entry& entry, const SparseMatrixd& P,
+                                       const VertexColumns& Pv) {
   const Index mv = P.cols() / 3;
-  const double* a_values = A.valuePtr();
   const double* p_values = P.valuePtr();
   // P_v's rows: for each fine vertex a, the coarse vertices I and the positions of w_aI.
-  const Index nv = A.cols() / 3;
   VertexColumns rows_of;
   rows_of.outer.assign(nv + 1, 0);
   for (const int a : Pv.rows)
@@ -323,14 +325,12 @@ SparseMatrixd blocked_galerkin_product(const SparseMatrixd& A, const VertexBlock
       for (int p = Pv.outer[J]; p < Pv.outer[J + 1]; ++p) {
         const int b = Pv.rows[p];
         const double w_bJ = p_values[Pv.at[p]];
-        const int stride = blocks.stride[b];
-        for (int e = blocks.columns.outer[b]; e < blocks.columns.outer[b + 1]; ++e) {
-          const int a = blocks.columns.rows[e];
-          const double* block_ab = a_values + blocks.columns.at[e];
+        for (int e = outer[b]; e < outer[b + 1]; ++e) {
+          const int a = block_rows[e];
           double ap[9];  // A(3a + r, 3b + c) · w_bJ at 3c + r
           for (int c = 0; c < 3; ++c)
             for (int r = 0; r < 3; ++r)
-              ap[3 * c + r] = block_ab[r + c * stride] * w_bJ;
+              ap[3 * c + r] = entry(b, e, r, c) * w_bJ;
           for (int q = rows_of.outer[a]; q < rows_of.outer[a + 1]; ++q) {
             const int I = rows_of.rows[q];
             const double w_aI = p_values[rows_of.at[q]];
@@ -370,8 +370,28 @@ bool galerkin_product_by_blocks(const SparseMatrixd& A, const SparseMatrixd& P) 
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
   if (A.rows() == P.rows())
     if (const std::optional<VertexColumns> Pv = vertex_prolongation(P))
-      if (const std::optional<VertexBlocks> blocks = vertex_blocks(A))
-        return blocked_galerkin_product(A, *blocks, P, *Pv);
+      if (const std::optional<VertexBlocks> blocks = vertex_blocks(A)) {
+        const double* values = A.valuePtr();
+        return blocked_galerkin_product(
+            A.cols() / 3, blocks->columns.outer.data(), blocks->columns.rows.data(),
+            [&](int b, int e, int r, int c) {
+              return values[blocks->columns.at[e] + r + c * blocks->stride[b]];
+            },
+            P, *Pv);
+      }
+  return scalar_galerkin_product(A, P);
+}
+
+SparseMatrixd galerkin_product(const SparseMatrixd& A, const BlockSymmetricMatrix& blocks,
+                               const SparseMatrixd& P) {
+  if (blocks.empty() || blocks.rows() != A.rows() || A.rows() != P.rows())
+    return galerkin_product(A, P);
+  if (const std::optional<VertexColumns> Pv = vertex_prolongation(P)) {
+    const double* values = blocks.block_values();
+    return blocked_galerkin_product(
+        blocks.rows() / 3, blocks.block_outer(), blocks.block_rows(),
+        [values](int, int e, int r, int c) { return values[9 * Index(e) + 3 * c + r]; }, P, *Pv);
+  }
   return scalar_galerkin_product(A, P);
 }
 
@@ -530,21 +550,20 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
                                 std::to_string(A.rows()) + " rows, the finest level " +
                                 std::to_string(m_prolongations.back().rows()));
   for (auto& level : m_levels)
-    level->blocks.clear();  // copied anew below, once every operator is in place
+    level->blocks.clear();  // copied anew below
   m_levels[L]->A = &A;
   m_levels[L]->owned.resize(0, 0);
+  // Finest first: the block copy of each level whose operator multiplies vectors (the smoothed
+  // ones and the finest, CG's; the large ones with a single-precision copy for the cycle's
+  // products), then the next coarser operator from it.
   for (int k = L - 1; k >= 0; --k) {
-    SparseMatrixd coarse = galerkin_product(*m_levels[k + 1]->A, m_prolongations[k]);
+    Level& fine = *m_levels[k + 1];
+    fine.blocks.keep_single_precision(fine.A->nonZeros() / 9 >=
+                                      m_options.single_precision_min_blocks);
+    fine.blocks.assign(*fine.A);
+    SparseMatrixd coarse = galerkin_product(*fine.A, fine.blocks, m_prolongations[k]);
     m_levels[k]->owned.swap(coarse);  // Eigen's assignment from a named matrix would copy it
     m_levels[k]->A = &m_levels[k]->owned;
-  }
-  // The levels whose operators multiply vectors: the smoothed ones and the finest (CG's), the
-  // large ones with a single-precision copy for the cycle's products.
-  for (int k = 1; k <= L; ++k) {
-    const SparseMatrixd& Ak = *m_levels[k]->A;
-    m_levels[k]->blocks.keep_single_precision(Ak.nonZeros() / 9 >=
-                                              m_options.single_precision_min_blocks);
-    m_levels[k]->blocks.assign(Ak);
   }
   if (L == 0) {
     m_levels[0]->blocks.keep_single_precision(false);

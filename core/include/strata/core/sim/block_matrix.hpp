@@ -29,6 +29,11 @@ class BlockSymmetricMatrix {
   }
   bool empty() const { return m_num_blocks == 0; }
   Index rows() const { return 3 * m_num_blocks; }
+  /// The blocks as assigned: those of block column b are block_outer()[b] … [b + 1], block e in
+  /// block row block_rows()[e], its entry (i, j) at block_values()[9e + 3j + i].
+  const int* block_outer() const { return m_outer.data(); }
+  const int* block_rows() const { return m_block_rows.data(); }
+  const double* block_values() const { return m_values.data(); }
 
   /// Block columns per parallel chunk of the products.
   static constexpr Index kBlockChunk = 512;
