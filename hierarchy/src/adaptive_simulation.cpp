@@ -443,9 +443,15 @@ void AdaptiveSimulation::make_dirichlet_exact() {
 bool AdaptiveSimulation::children_stable(NodeId n) const {
   // The eight children as a mesh of their own: its lumped masses are at most those of the
   // children in any cut, so its estimate is a lower bound of theirs (refusal errs on the safe
-  // side).
+  // side). The answer holds for the whole run (the shapes, the material and dt stay), so it is
+  // kept per node, by its place in the tree, which outlives node ids.
+  const std::pair<int, std::uint64_t> path = node_path(n);
+  if (const auto known = m_children_stable.find(path); known != m_children_stable.end())
+    return known->second;
   const std::array<Matrix3x4d, 8> children = red_refine_tet(m_tree->bey_positions(n));
-  return stable_on_their_own({children.begin(), children.end()});
+  const bool stable = stable_on_their_own({children.begin(), children.end()});
+  m_children_stable.emplace(path, stable);
+  return stable;
 }
 
 bool AdaptiveSimulation::stable_on_their_own(const std::vector<Matrix3x4d>& tets) const {
@@ -584,7 +590,9 @@ void AdaptiveSimulation::advance_with_redo() {
   double attempt = seconds_since(step_start);
   m_stepping_seconds += attempt;
   for (int pass = 0; pass < m_settings.max_passes && adapting(); ++pass) {
+    const auto decision_start = Clock::now();
     const CutChanges changes = decide(true, false);
+    m_bookkeeping_seconds += seconds_since(decision_start);
     if (changes.refine.empty()) break;
     ++m_report.redone_steps;
     m_report.redo_seconds += attempt;

@@ -46,6 +46,7 @@
 /// shifted to keep ½ Σ m v² and the momentum exactly; when prescribed vertices took over mass from
 /// the region (coarser cuts lump more mass onto them), both cannot hold and the kinetic energy is
 /// kept with the momentum's direction (a cut change never adds kinetic energy).
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -434,6 +435,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// meets the cut its peak needs. On a cut coarser than that (the roots) the estimate of a
   /// load's first steps sees too little of it to refine in time.
   std::set<std::pair<int, std::uint64_t>> m_load_floor;
+  /// children_stable() of the nodes asked so far, by node_path.
+  mutable std::map<std::pair<int, std::uint64_t>, bool> m_children_stable;
   /// Whether the decision in progress keeps the cut at least as fine as m_load_floor.
   bool m_hold_load_floor = false;
   std::pair<int, std::uint64_t> node_path(NodeId n) const;
