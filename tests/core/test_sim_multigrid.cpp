@@ -172,6 +172,10 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
     });
     EXPECT_FALSE(galerkin_product_by_blocks(A_partial, P));
     EXPECT_TRUE(same_bits(galerkin_product(A_partial, P), scalar_galerkin_product(A_partial, P)));
+    BlockSymmetricMatrix partial_copy;  // a copy that failed holds nothing: entry by entry
+    EXPECT_FALSE(partial_copy.assign(A_partial));
+    EXPECT_TRUE(same_bits(galerkin_product(A_partial, partial_copy, P),
+                          scalar_galerkin_product(A_partial, P)));
     SparseMatrixd A_zero = A;
     A_zero.valuePtr()[A_zero.outerIndexPtr()[4] + 1] = 0.0;  // stored, not removed
     EXPECT_TRUE(galerkin_product_by_blocks(A_zero, P));
@@ -182,6 +186,8 @@ TEST(Multigrid, GalerkinProductByVertexBlocksIsTheScalarOneBitForBit) {
         same_bits(galerkin_product(A_zero, zero_copy, P), scalar_galerkin_product(A_zero, P)));
     EXPECT_FALSE(galerkin_product_by_blocks(A, kron3(Pv, Eigen::Matrix3d::Identity())));  // zeros
     const SparseMatrixd C = galerkin_product(A_dropped, P_dropped);
+    // A copy of another size (A's, not A_dropped's) is not read.
+    EXPECT_TRUE(same_bits(galerkin_product(A_dropped, copy, P_dropped), C));
     const SparseMatrixd expected_dropped =
         SparseMatrixd(P_dropped.transpose()) * (A_dropped * P_dropped);
     EXPECT_TRUE(same_bits(C, scalar_galerkin_product(A_dropped, P_dropped)));

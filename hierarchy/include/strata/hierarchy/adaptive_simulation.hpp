@@ -435,7 +435,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// meets the cut its peak needs. On a cut coarser than that (the roots) the estimate of a
   /// load's first steps sees too little of it to refine in time.
   std::set<std::pair<int, std::uint64_t>> m_load_floor;
-  /// children_stable() of the nodes asked so far, by node_path.
+  /// children_stable() of the nodes asked so far, by node_path (written from const calls: serial
+  /// callers only, as the refinement controller's are).
   mutable std::map<std::pair<int, std::uint64_t>, bool> m_children_stable;
   /// Whether the decision in progress keeps the cut at least as fine as m_load_floor.
   bool m_hold_load_floor = false;

@@ -85,9 +85,11 @@ struct MultigridOptions {
 /// vertex blocks, by blocks; otherwise entry by entry (scalar_galerkin_product). Both add the
 /// same products in the same order: the results are the same bit for bit.
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
-/// The same, reading A's values from `blocks`, A's block copy (BlockSymmetricMatrix::assign(A)),
-/// where the product goes by blocks: nine values together per block instead of three columns
-/// apart, and no analysis of A's pattern. The same result bit for bit.
+/// The same, reading A's values from `blocks`, A's block copy (BlockSymmetricMatrix::assign(A)
+/// with A's current values: a copy of another matrix of A's size would be read as A), where the
+/// product goes by blocks: nine values together per block instead of three columns apart, and no
+/// analysis of A's pattern. The same result bit for bit; an empty copy or one of another size is
+/// not read.
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const BlockSymmetricMatrix& blocks,
                                const SparseMatrixd& P);
 SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
