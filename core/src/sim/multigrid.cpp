@@ -177,6 +177,14 @@ SparseMatrixd joined(const std::vector<Fragment>& fragments, Index n) {
   return C;
 }
 
+/// One thread's column of a Galerkin product being summed: the values by row, the column that
+/// last wrote each row (mark) and the rows written for the current one (touched).
+struct ColumnAccumulator {
+  std::vector<double> value;
+  std::vector<Index> mark;
+  std::vector<int> touched;
+};
+
 /// A sparse matrix by vertices: the column lists of an nv × mv pattern, with the positions of
 /// its entries in the scalar matrix it came from.
 struct VertexColumns {
@@ -218,70 +226,14 @@ std::optional<VertexColumns> vertex_prolongation(const SparseMatrixd& P) {
   return result;
 }
 
-/// A by 3 × 3 blocks when each vertex column's three scalar columns hold the same complete row
-/// triples (3a, 3a + 1, 3a + 2): block (a, b) entry (r, c) at values[at + r + c · 3 · (column
-/// length)] … given as the block's (0, 0) position and its column's stride.
-struct VertexBlocks {
-  VertexColumns columns;
-  std::vector<int> stride;  ///< per vertex column b: the distance between its scalar columns
-};
-
-std::optional<VertexBlocks> vertex_blocks(const SparseMatrixd& A) {
-  if (!A.isCompressed() || A.rows() % 3 != 0 || A.cols() != A.rows()) return std::nullopt;
-  const int* outer = A.outerIndexPtr();
-  const int* inner = A.innerIndexPtr();
-  VertexBlocks result;
-  const Index nv = A.cols() / 3;
-  result.columns.outer.assign(nv + 1, 0);
-  result.stride.resize(nv);
-  // Vertex columns in parallel: first checked and counted, then written at their offsets.
-  const bool whole = tbb::parallel_reduce(
-      tbb::blocked_range<Index>(0, nv, 1024), true,
-      [&](const tbb::blocked_range<Index>& range, bool ok) {
-        for (Index b = range.begin(); ok && b != range.end(); ++b) {
-          const int first = outer[3 * b];
-          const int count = outer[3 * b + 1] - first;
-          ok = count % 3 == 0;
-          for (int c = 1; ok && c < 3; ++c)
-            ok = outer[3 * b + c + 1] - outer[3 * b + c] == count &&
-                 std::equal(inner + first, inner + first + count, inner + outer[3 * b + c]);
-          for (int k = 0; ok && k < count; k += 3) {
-            const int row = inner[first + k];
-            ok = row % 3 == 0 && inner[first + k + 1] == row + 1 && inner[first + k + 2] == row + 2;
-          }
-          result.columns.outer[b + 1] = count / 3;
-          result.stride[b] = count;
-        }
-        return ok;
-      },
-      std::logical_and<bool>());
-  if (!whole) return std::nullopt;
-  for (Index b = 0; b < nv; ++b)
-    result.columns.outer[b + 1] += result.columns.outer[b];
-  result.columns.rows.resize(result.columns.outer[nv]);
-  result.columns.at.resize(result.columns.outer[nv]);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nv, 1024),
-                    [&](const tbb::blocked_range<Index>& range) {
-                      for (Index b = range.begin(); b != range.end(); ++b) {
-                        const int first = outer[3 * b];
-                        for (int e = result.columns.outer[b], k = 0;
-                             e < result.columns.outer[b + 1]; ++e, k += 3) {
-                          result.columns.rows[e] = inner[first + k] / 3;
-                          result.columns.at[e] = first + k;
-                        }
-                      }
-                    });
-  return result;
-}
-
-/// PᵀAP by 3 × 3 blocks (P = P_v ⊗ I₃, A by blocks): the same products added in the same order
-/// as the scalar product below, entry by entry, so the result is bit for bit the same. A's blocks
-/// are given by block column (`outer`, `block_rows`: its nv block columns) and
-/// `entry(b, e, r, c)`, the value (r, c) of block e of column b.
-template <typename Entry>
-SparseMatrixd blocked_galerkin_product(Index nv, const int* outer, const int* block_rows,
-                                       const Entry& entry, const SparseMatrixd& P,
+/// PᵀAP by 3 × 3 blocks (P = P_v ⊗ I₃, A by its block copy): the same products added in the
+/// same order as the scalar product below, entry by entry, so the result is bit for bit the same.
+SparseMatrixd blocked_galerkin_product(const BlockSymmetricMatrix& A, const SparseMatrixd& P,
                                        const VertexColumns& Pv) {
+  const Index nv = A.rows() / 3;
+  const int* outer = A.block_outer();
+  const int* block_rows = A.block_rows();
+  const double* a_values = A.block_values();
   const Index mv = P.cols() / 3;
   const double* p_values = P.valuePtr();
   // P_v's rows: for each fine vertex a, the coarse vertices I and the positions of w_aI.
@@ -305,14 +257,10 @@ SparseMatrixd blocked_galerkin_product(Index nv, const int* outer, const int* bl
   constexpr Index kBlock = 170;  // vertex columns per task (about 512 scalar columns)
   const Index num_blocks = (mv + kBlock - 1) / kBlock;
   std::vector<Fragment> fragments(num_blocks);
-  struct Accumulator {
-    std::vector<double> value;  // 9 per coarse vertex: (r, c) at 3c + r
-    std::vector<Index> mark;
-    std::vector<int> touched;
-  };
-  tbb::enumerable_thread_specific<Accumulator> accumulators;
+  // value: 9 per coarse vertex, (r, c) at 3c + r.
+  tbb::enumerable_thread_specific<ColumnAccumulator> accumulators;
   tbb::parallel_for(Index(0), num_blocks, [&](Index block) {
-    Accumulator& acc = accumulators.local();
+    ColumnAccumulator& acc = accumulators.local();
     if (static_cast<Index>(acc.mark.size()) != mv) {
       acc.value.assign(9 * mv, 0.0);
       acc.mark.assign(mv, -1);
@@ -328,9 +276,9 @@ SparseMatrixd blocked_galerkin_product(Index nv, const int* outer, const int* bl
         for (int e = outer[b]; e < outer[b + 1]; ++e) {
           const int a = block_rows[e];
           double ap[9];  // A(3a + r, 3b + c) · w_bJ at 3c + r
-          for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 3; ++r)
-              ap[3 * c + r] = entry(b, e, r, c) * w_bJ;
+          const double* block_ab = a_values + 9 * static_cast<Index>(e);
+          for (int k = 0; k < 9; ++k)
+            ap[k] = block_ab[k] * w_bJ;
           for (int q = rows_of.outer[a]; q < rows_of.outer[a + 1]; ++q) {
             const int I = rows_of.rows[q];
             const double w_aI = p_values[rows_of.at[q]];
@@ -363,36 +311,34 @@ SparseMatrixd blocked_galerkin_product(Index nv, const int* outer, const int* bl
 
 }  // namespace
 
+namespace {
+
+/// By blocks where `blocks` holds A and P = P_v ⊗ I₃; otherwise entry by entry.
+SparseMatrixd blocked_or_scalar_product(const SparseMatrixd& A, const BlockSymmetricMatrix& blocks,
+                                        const SparseMatrixd& P) {
+  if (!blocks.empty() && blocks.rows() == A.rows() && A.rows() == P.rows())
+    if (const std::optional<VertexColumns> Pv = vertex_prolongation(P))
+      return blocked_galerkin_product(blocks, P, *Pv);
+  return scalar_galerkin_product(A, P);
+}
+
+}  // namespace
+
 bool galerkin_product_by_blocks(const SparseMatrixd& A, const SparseMatrixd& P) {
-  return A.rows() == P.rows() && vertex_prolongation(P).has_value() && vertex_blocks(A).has_value();
+  return A.rows() == P.rows() && vertex_prolongation(P).has_value() &&
+         BlockSymmetricMatrix().assign(A);
 }
 
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
-  if (A.rows() == P.rows())
-    if (const std::optional<VertexColumns> Pv = vertex_prolongation(P))
-      if (const std::optional<VertexBlocks> blocks = vertex_blocks(A)) {
-        const double* values = A.valuePtr();
-        return blocked_galerkin_product(
-            A.cols() / 3, blocks->columns.outer.data(), blocks->columns.rows.data(),
-            [&](int b, int e, int r, int c) {
-              return values[blocks->columns.at[e] + r + c * blocks->stride[b]];
-            },
-            P, *Pv);
-      }
-  return scalar_galerkin_product(A, P);
+  BlockSymmetricMatrix blocks;
+  blocks.assign(A);  // holds nothing unless A is made of whole blocks
+  return blocked_or_scalar_product(A, blocks, P);
 }
 
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const BlockSymmetricMatrix& blocks,
                                const SparseMatrixd& P) {
-  if (blocks.empty() || blocks.rows() != A.rows() || A.rows() != P.rows())
-    return galerkin_product(A, P);
-  if (const std::optional<VertexColumns> Pv = vertex_prolongation(P)) {
-    const double* values = blocks.block_values();
-    return blocked_galerkin_product(
-        blocks.rows() / 3, blocks.block_outer(), blocks.block_rows(),
-        [values](int, int e, int r, int c) { return values[9 * Index(e) + 3 * c + r]; }, P, *Pv);
-  }
-  return scalar_galerkin_product(A, P);
+  if (blocks.empty() || blocks.rows() != A.rows()) return galerkin_product(A, P);
+  return blocked_or_scalar_product(A, blocks, P);
 }
 
 SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P) {
@@ -402,14 +348,9 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
   constexpr Index kBlock = 512;
   const Index num_blocks = (m + kBlock - 1) / kBlock;
   std::vector<Fragment> fragments(num_blocks);
-  struct Accumulator {
-    std::vector<double> value;
-    std::vector<Index> mark;
-    std::vector<int> touched;
-  };
-  tbb::enumerable_thread_specific<Accumulator> accumulators;
+  tbb::enumerable_thread_specific<ColumnAccumulator> accumulators;
   tbb::parallel_for(Index(0), num_blocks, [&](Index block) {
-    Accumulator& acc = accumulators.local();
+    ColumnAccumulator& acc = accumulators.local();
     if (static_cast<Index>(acc.value.size()) != m) {
       acc.value.assign(m, 0.0);
       acc.mark.assign(m, -1);
@@ -445,54 +386,33 @@ SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrix
 
 namespace {
 
-/// max_j Σ_i |A_ij| / A_jj over columns j in [begin, end) (A symmetric, both triangles stored),
-/// D⁻¹ from `inverse_diagonal`, or written into `*inverse_diagonal_out` from the same pass when it
-/// is given (zero where a diagonal entry is missing or not positive).
-double column_row_sums(const SparseMatrixd& A, Index begin, Index end,
-                       const VectorXd& inverse_diagonal, VectorXd* inverse_diagonal_out) {
-  double bound = 0.0;
-  for (Index j = begin; j != end; ++j) {
-    double sum = 0.0, diagonal = 0.0;
-    for (SparseMatrixd::InnerIterator it(A, j); it; ++it) {
-      sum += std::abs(it.value());
-      if (it.index() == j) diagonal = it.value();
-    }
-    double inverse = 0.0;
-    if (inverse_diagonal_out != nullptr) {
-      inverse = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
-      (*inverse_diagonal_out)[j] = inverse;
-    } else {
-      inverse = inverse_diagonal[j];
-    }
-    bound = std::max(bound, sum * inverse);
-  }
-  return bound;
-}
-
-/// The row-sum (Gershgorin) bound of the spectrum of D⁻¹A, over ranges of columns in parallel (a
-/// maximum: the same at any thread count). With `inverse_diagonal_out`, D⁻¹ is written there in
-/// the same pass; otherwise `inverse_diagonal` is read.
-double parallel_row_sums(const SparseMatrixd& A, const VectorXd& inverse_diagonal,
-                         VectorXd* inverse_diagonal_out) {
-  if (inverse_diagonal_out != nullptr) inverse_diagonal_out->resize(A.cols());
+/// The row-sum (Gershgorin) bound max_j Σ_i |A_ij| / A_jj of the spectrum of D⁻¹A (A symmetric,
+/// both triangles stored), over ranges of columns in parallel (a maximum: the same at any thread
+/// count). D⁻¹ is read from `inverse_in`, or, when `inverse_out` is given instead, written there
+/// from the same pass (zero where a diagonal entry is missing or not positive).
+double row_sum_bound(const SparseMatrixd& A, const VectorXd* inverse_in, VectorXd* inverse_out) {
+  if (inverse_out != nullptr) inverse_out->resize(A.cols());
   return tbb::parallel_reduce(
       tbb::blocked_range<Index>(0, A.outerSize(), 2048), 0.0,
       [&](const tbb::blocked_range<Index>& range, double bound) {
-        return std::max(bound, column_row_sums(A, range.begin(), range.end(), inverse_diagonal,
-                                               inverse_diagonal_out));
+        for (Index j = range.begin(); j != range.end(); ++j) {
+          double sum = 0.0, diagonal = 0.0;
+          for (SparseMatrixd::InnerIterator it(A, j); it; ++it) {
+            sum += std::abs(it.value());
+            if (it.index() == j) diagonal = it.value();
+          }
+          double inverse = 0.0;
+          if (inverse_out != nullptr) {
+            inverse = diagonal > 0.0 ? 1.0 / diagonal : 0.0;
+            (*inverse_out)[j] = inverse;
+          } else {
+            inverse = (*inverse_in)[j];
+          }
+          bound = std::max(bound, sum * inverse);
+        }
+        return bound;
       },
       [](double a, double b) { return std::max(a, b); });
-}
-
-/// max_j Σ_i |A_ij| / A_jj for the given D⁻¹.
-double row_sum_bound(const SparseMatrixd& A, const VectorXd& inverse_diagonal) {
-  return parallel_row_sums(A, inverse_diagonal, nullptr);
-}
-
-/// D⁻¹ of A into `inverse_diagonal` and the row-sum bound of D⁻¹A, from one pass.
-double inverse_diagonal_and_row_sum_bound(const SparseMatrixd& A, VectorXd& inverse_diagonal) {
-  static const VectorXd kUnused;
-  return parallel_row_sums(A, kUnused, &inverse_diagonal);
 }
 
 }  // namespace
@@ -628,7 +548,7 @@ void MultigridPreconditioner::seed_smoother_estimates(std::vector<SmootherEstima
 
 void MultigridPreconditioner::setup_smoother(Level& level, const SmootherEstimate& seed) {
   const SparseMatrixd& A = *level.A;
-  const double gershgorin = inverse_diagonal_and_row_sum_bound(A, level.inverse_diagonal);
+  const double gershgorin = row_sum_bound(A, nullptr, &level.inverse_diagonal);
   if (seed.lambda > 0.0) {
     // Above the row-sum bound an estimate is certainly too high for this operator.
     set_smoother_interval(level, std::min(seed.lambda, gershgorin), gershgorin);
@@ -705,7 +625,7 @@ void MultigridPreconditioner::widen_smoother_intervals() {
     Level& level = *m_levels[k];
     if (level.A != nullptr && level.inverse_diagonal.size() == level.A->rows())
       level.lambda_max =
-          std::max(level.lambda_max, row_sum_bound(*level.A, level.inverse_diagonal));
+          std::max(level.lambda_max, row_sum_bound(*level.A, &level.inverse_diagonal, nullptr));
   }
 }
 

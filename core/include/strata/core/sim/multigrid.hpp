@@ -82,14 +82,13 @@ struct MultigridOptions {
 /// PᵀAP for a symmetric A (both triangles, column-major), computed column by column in parallel
 /// (no intermediate A P); the result has both triangles, rows sorted in each column. When P
 /// prolongs each vertex's three DOFs alike (P = P_v ⊗ I₃) and A's pattern is made of whole 3 × 3
-/// vertex blocks, by blocks; otherwise entry by entry (scalar_galerkin_product). Both add the
-/// same products in the same order: the results are the same bit for bit.
+/// vertex blocks, by blocks from a block copy of A (BlockSymmetricMatrix); otherwise entry by
+/// entry (scalar_galerkin_product). Both add the same products in the same order: the results are
+/// the same bit for bit.
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
-/// The same, reading A's values from `blocks`, A's block copy (BlockSymmetricMatrix::assign(A)
-/// with A's current values: a copy of another matrix of A's size would be read as A), where the
-/// product goes by blocks: nine values together per block instead of three columns apart, and no
-/// analysis of A's pattern. The same result bit for bit; an empty copy or one of another size is
-/// not read.
+/// The same from `blocks`, a block copy already made of A (BlockSymmetricMatrix::assign(A) with
+/// A's current values: a copy of another matrix of A's size would be read as A). An empty copy or
+/// one of another size is not read.
 SparseMatrixd galerkin_product(const SparseMatrixd& A, const BlockSymmetricMatrix& blocks,
                                const SparseMatrixd& P);
 SparseMatrixd scalar_galerkin_product(const SparseMatrixd& A, const SparseMatrixd& P);
