@@ -440,7 +440,8 @@ TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErro
   const CliResult result = run_strata("run huge.json", folder.path());
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_EQ(result.err,
-            "strata: error: huge.json: number overflow parsing '1e400' (not a finite double)\n");
+            "strata: error: huge.json: line 1, column 45: number overflow parsing '1e400' (not a "
+            "finite double)\n");
   // Finite values whose products overflow: the weight, or the stiffness.
   json scene = bar_scene();
   scene["gravity"] = {0, 0, -1e300};
@@ -519,6 +520,17 @@ TEST(CliEndToEnd, KeysTheRunDoesNotUseAreWarnedAbout) {
             "strata: warning: scene.json: solver.load_steps: applies to static runs only "
             "(ignored)\nstrata: warning: scene.json: hierarchy.level: mode \"full\" runs on the "
             "finest level (ignored)\n");
+  // The keys of adaptation, in a mode that does not adapt.
+  scene["solver"].erase("load_steps");
+  scene["hierarchy"] = {
+      {"levels", 1}, {"mode", "full"}, {"tolerance", 0.05}, {"max_active_elements", 100}};
+  write_scene(folder, scene);
+  result = run_strata("run scene.json -q", folder.path());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.err,
+            "strata: warning: scene.json: hierarchy.max_active_elements: mode \"full\" does not "
+            "adapt (ignored)\nstrata: warning: scene.json: hierarchy.tolerance: mode \"full\" does "
+            "not adapt (ignored)\n");
 }
 
 TEST(CliEndToEnd, OutputFolderAndProgressFileProblemsAreBadInput) {
@@ -533,9 +545,13 @@ TEST(CliEndToEnd, OutputFolderAndProgressFileProblemsAreBadInput) {
                     "--out: the output folder must not be empty");
   expect_error_line(folder, "run scene.json --out o --progress-file nodir/p.txt",
                     "--progress-file 'nodir/p.txt': cannot write it (no folder 'nodir')");
-  expect_error_line(folder, "run scene.json --out o --progress-file o",
-                    "--progress-file 'o': cannot write it (it is a folder)");
-  EXPECT_FALSE(std::filesystem::exists(folder.path() / "o" / "stats.json"));
+  // The run failed before writing anything: the folder it created is gone again.
+  EXPECT_FALSE(std::filesystem::exists(folder.path() / "o"));
+  std::filesystem::create_directories(folder.path() / "p");
+  expect_error_line(folder, "run scene.json --out p --progress-file p",
+                    "--progress-file 'p': cannot write it (it is a folder)");
+  EXPECT_TRUE(std::filesystem::exists(folder.path() / "p"));  // not created by the run
+  EXPECT_FALSE(std::filesystem::exists(folder.path() / "p" / "stats.json"));
   expect_error_line(folder, "run scene.json --threads abc",
                     "--threads: expected a whole number, got 'abc'");
   expect_error_line(folder, "run scene.json --threads -1",

@@ -112,6 +112,16 @@ TEST(CliHierarchy, BadHierarchyKeysNameTheKey) {
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.err, HasSubstr("hierarchy.level"));
 
+  // An adaptive cut that starts deeper than refinement may reach.
+  scene = slab_scene("adaptive");
+  scene["hierarchy"]["level"] = 2;
+  scene["hierarchy"]["max_level"] = 1;
+  write_text(folder.path() / "deeper.json", scene.dump());
+  result = run_strata("run deeper.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.err, HasSubstr("hierarchy.level: is 2, deeper than max_level 1"));
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+
   scene = slab_scene("adaptive");
   scene["hierarchy"]["refine_threshold"] = -1;
   write_text(folder.path() / "threshold.json", scene.dump());

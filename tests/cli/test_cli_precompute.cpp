@@ -129,7 +129,9 @@ TEST(CliPrecompute, BadInputGetsOneLineErrors) {
   EXPECT_THAT(error("run other.json -q" + precomputed + " --set hierarchy.cut='\"cut.json\"'"),
               HasSubstr("hierarchy.cut (cut.json): made for a coarse mesh of 50 vertices"));
   EXPECT_THAT(error("run train.json -q" + precomputed + " --set hierarchy.cut='\"none.json\"'"),
-              HasSubstr("none.json"));
+              HasSubstr("train.json: hierarchy.cut: "));
+  EXPECT_THAT(error("run train.json -q" + precomputed + " --set hierarchy.cut='\"none.json\"'"),
+              HasSubstr("none.json: cannot open"));
   json cut = read_json(folder.path() / "cut.json");
   cut["windows"][0]["refined"].push_back("3.9");
   write_text(folder.path() / "bad.json", cut.dump());

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <exception>
 #include <sstream>
 #include <system_error>
 
@@ -33,9 +34,11 @@ void check_output_folder(const std::filesystem::path& folder) {
   }
 }
 
-OutputFolder::OutputFolder(const std::filesystem::path& folder) {
+OutputFolder::OutputFolder(const std::filesystem::path& folder)
+    : m_folder(folder), m_exceptions(std::uncaught_exceptions()) {
   check_output_folder(folder);
   std::error_code error;
+  m_created = !std::filesystem::exists(folder, error);
   std::filesystem::create_directories(folder, error);
   if (error)
     throw InputError("output folder '" + folder.string() + "': cannot create it (" +
@@ -55,6 +58,12 @@ OutputFolder::OutputFolder(const std::filesystem::path& folder) {
 
 OutputFolder::~OutputFolder() {
   if (m_lock >= 0) ::close(m_lock);  // closing releases the lock
+  // A run that failed before writing anything leaves no folder it created behind.
+  if (m_created && std::uncaught_exceptions() > m_exceptions) {
+    std::error_code error;
+    std::filesystem::remove(m_folder / ".strata.lock", error);
+    std::filesystem::remove(m_folder, error);  // only if empty
+  }
 }
 
 std::string format_double(double value) {

@@ -30,7 +30,11 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
     if (name.empty()) value.at("cut").fail("must not be empty");
     std::filesystem::path path(name);
     if (!path.is_absolute()) path = folder / path;
-    settings.precomputed = std::make_shared<const PrecomputedCut>(read_cut_file(path));
+    try {
+      settings.precomputed = std::make_shared<const PrecomputedCut>(read_cut_file(path));
+    } catch (const InputError& error) {
+      value.at("cut").fail(error.what());
+    }
     if (settings.precomputed->levels != settings.levels) {
       value.at("levels").fail("is " + std::to_string(settings.levels) + ", and the cut '" + name +
                               "' was recorded with " +
@@ -91,6 +95,11 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
   if (value.has("max_level")) {
     criteria.max_level = value.at("max_level").integer(0);
     if (criteria.max_level > settings.levels) value.at("max_level").fail("must be at most levels");
+    if (settings.mode == HierarchyMode::adaptive && value.has("level") &&
+        settings.level > criteria.max_level)
+      value.at("level").fail("is " + std::to_string(settings.level) + ", deeper than max_level " +
+                             std::to_string(criteria.max_level) +
+                             " (the cut starts where refinement may not reach)");
   }
   if (value.has("balance")) criteria.balance = value.at("balance").boolean();
   try {

@@ -1,5 +1,6 @@
 #include "strata/app/scene_parser.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -458,7 +459,21 @@ nlohmann::json read_json_file(const std::filesystem::path& file) {
     // "[json.exception.out_of_range.406] number overflow parsing '1e400'"
     const std::string what = error.what();
     const std::size_t start = what.find("] ");
-    throw InputError(file.string() + ": " +
+    std::string where;
+    // The number's place in the file: the quoted literal of the message, found in the text.
+    const std::size_t open = what.find('\''), close = what.rfind('\'');
+    if (open != std::string::npos && close > open + 1) {
+      const std::string literal = what.substr(open + 1, close - open - 1);
+      const std::string content = text.str();
+      const std::size_t at = content.find(literal);
+      if (at != std::string::npos) {
+        const std::size_t line_start = content.rfind('\n', at);
+        const auto line = 1 + std::count(content.begin(), content.begin() + at, '\n');
+        const std::size_t column = at - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
+        where = "line " + std::to_string(line) + ", column " + std::to_string(column) + ": ";
+      }
+    }
+    throw InputError(file.string() + ": " + where +
                      (start == std::string::npos ? what : what.substr(start + 2)) +
                      " (not a finite double)");
   }
@@ -575,10 +590,20 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   }
   if (top.has("hierarchy"))
     scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"), file.parent_path());
-  if (scene.hierarchy && scene.hierarchy->mode == HierarchyMode::full &&
-      top.at("hierarchy").has("level"))
-    scene.ignored_keys.push_back(
-        "hierarchy.level: mode \"full\" runs on the finest level (ignored)");
+  if (scene.hierarchy && scene.hierarchy->mode == HierarchyMode::full) {
+    const SceneValue hierarchy = top.at("hierarchy");
+    if (hierarchy.has("level"))
+      scene.ignored_keys.push_back(
+          "hierarchy.level: mode \"full\" runs on the finest level (ignored)");
+    for (const char* key :
+         {"adapt_every", "max_passes", "indicator", "refine_threshold", "coarsen_tolerance",
+          "coarsen_indicator_fraction", "stress_floor", "min_steps_between_changes",
+          "max_active_elements", "max_level", "balance", "tolerance", "initial_adaptation",
+          "in_step_refinement", "full_resolution_fraction", "coarsen_budget"})
+      if (hierarchy.has(key))
+        scene.ignored_keys.push_back(std::string("hierarchy.") + key +
+                                     ": mode \"full\" does not adapt (ignored)");
+  }
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {
     throw SceneKeyError(file_name, "fixed",

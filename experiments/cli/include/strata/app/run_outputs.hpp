@@ -26,13 +26,17 @@ void check_output_folder(const std::filesystem::path& folder);
 class OutputFolder {
  public:
   /// Creates `folder` if needed and takes it; throws InputError if it cannot be created or
-  /// another run holds it.
+  /// another run holds it. A folder it created is removed again if it is destroyed by an
+  /// exception while empty (a run that failed before writing any output).
   explicit OutputFolder(const std::filesystem::path& folder);
   ~OutputFolder();
   OutputFolder(const OutputFolder&) = delete;
   OutputFolder& operator=(const OutputFolder&) = delete;
 
  private:
+  std::filesystem::path m_folder;
+  int m_exceptions = 0;  ///< uncaught exceptions at construction
+  bool m_created = false;
   int m_lock = -1;
 };
 
