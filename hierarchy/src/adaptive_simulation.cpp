@@ -564,6 +564,8 @@ void AdaptiveSimulation::advance_step() {
       m_stepping_seconds += seconds_since(solve_start);
       if (m_estimates_error) measure_estimate(refined_estimate, m_simulation->positions(), carried);
     }
+    // Every pass refined: the load step's last solve was not judged again.
+    if (passes == m_settings.max_passes && adapting()) ++m_report.steps_out_of_passes;
     // The baseline of the next calibration: the cut the passes ended on, or a cut no pass has
     // measured yet (the first load step's, or one the merges between load steps changed).
     if (m_estimates_error && (passes > 0 || m_calibrated_shares.size() == 0))
@@ -589,7 +591,8 @@ void AdaptiveSimulation::advance_with_redo() {
   m_simulation->advance();
   double attempt = seconds_since(step_start);
   m_stepping_seconds += attempt;
-  for (int pass = 0; pass < m_settings.max_passes && adapting(); ++pass) {
+  int pass = 0;
+  for (; pass < m_settings.max_passes && adapting(); ++pass) {
     const auto decision_start = Clock::now();
     const CutChanges changes = decide(true, false);
     m_bookkeeping_seconds += seconds_since(decision_start);
@@ -611,6 +614,8 @@ void AdaptiveSimulation::advance_with_redo() {
     attempt = seconds_since(step_start);
     m_stepping_seconds += attempt;
   }
+  // Every pass refined: the step's last attempt was not judged again.
+  if (pass == m_settings.max_passes && adapting()) ++m_report.steps_out_of_passes;
   record_contact_step();
   if (adapting() && step_count() % m_settings.adapt_every == 0 && !finished())
     adapt(0, false, true);

@@ -158,6 +158,15 @@ TEST(AdaptiveTolerance, InStepRefinementRedoesStepsWithoutAnInitialAdaptation) {
   EXPECT_EQ(steps, static_cast<long>(adaptive.size()));  // a redone step counts once
   EXPECT_GT(report.redo_seconds, 0.0);
   EXPECT_LE(run_error(adaptive, full), h.tolerance);
+  EXPECT_EQ(report.steps_out_of_passes, 0);  // each step's passes ended on a judged attempt
+
+  // One pass per step from the roots: the first step's only pass refines, and its redone attempt
+  // is not judged again; the report counts it.
+  h.max_passes = 1;
+  ToleranceReport one_pass;
+  plate.run(h, &one_pass);
+  EXPECT_GT(one_pass.steps_out_of_passes, 0);
+  EXPECT_LE(one_pass.steps_out_of_passes, one_pass.redone_steps);
 }
 
 TEST(AdaptiveTolerance, AToleranceTheCutCannotMeetIsReported) {

@@ -237,6 +237,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
   // A run that stopped early met nothing to its end.
   block["tolerance_met"] = finished && report.steps_over_tolerance == 0;
   block["steps_over_tolerance"] = report.steps_over_tolerance;
+  block["steps_out_of_passes"] = report.steps_out_of_passes;
   block["estimate_scale"] = report.estimate_scale;
   block["refused_refinements"] = report.refused_refinements;
   block["redone_steps"] = report.redone_steps;
@@ -619,7 +620,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
       } else {
         std::cerr << "; " << report.refused_refinements
                   << " refinements refused by max_level, max_active_elements, the explicit step "
-                     "limit or hysteresis)\n";
+                     "limit or hysteresis";
+        if (report.steps_out_of_passes > 0)
+          std::cerr << "; " << report.steps_out_of_passes << " steps still refining after all "
+                    << adaptive->settings().max_passes << " hierarchy.max_passes";
+        std::cerr << ")\n";
       }
     }
   }

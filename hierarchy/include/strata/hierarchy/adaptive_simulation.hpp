@@ -192,7 +192,10 @@ struct ToleranceReport {
   /// Refinements the criteria asked for but could not make (max_level, element budget, explicit
   /// step veto, hysteresis) over the run.
   long refused_refinements = 0;
-  long redone_steps = 0;               ///< redo passes: dynamic steps redone on a refined cut
+  long redone_steps = 0;  ///< redo passes: dynamic steps redone on a refined cut
+  /// Accepted steps (static: load steps) whose every pass of hierarchy.max_passes refined, so that
+  /// the last attempt was not judged again.
+  long steps_out_of_passes = 0;
   long calibration_passes = 0;         ///< static: passes made to measure a grown estimate again
   double redo_seconds = 0.0;           ///< wall time of the discarded attempts [s]
   int initial_refinements = 0;         ///< nodes refined by the initial adaptation
