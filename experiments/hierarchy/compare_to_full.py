@@ -128,7 +128,7 @@ def main():
                  "estimated_error": h.get("estimated_error"),
                  "redone_steps": h.get("redone_steps"),
                  "warnings": stats.get("warnings", [])}
-        if h.get("mode") == "adaptive" and h.get("tolerance") is not None:
+        if h.get("mode") in ("adaptive", "precomputed") and h.get("tolerance") is not None:
             entry["tolerance"] = h["tolerance"]
             entry["tolerance_met"] = h.get("tolerance_met")
             entry["within_tolerance"] = entry["error"] <= h["tolerance"]

@@ -41,7 +41,8 @@ HierarchySettings parse_hierarchy(const SceneValue& value, const std::filesystem
                               std::to_string(settings.precomputed->levels) +
                               " levels (a cut belongs to one tree)");
     }
-  } else if (value.has("cut")) {
+  } else if (value.has("cut") && settings.mode != HierarchyMode::full) {
+    // Mode full (a precomputed scene's full-resolution reference) ignores it with a warning.
     value.at("cut").fail("only with mode \"precomputed\"");
   }
   if (value.has("level")) {

@@ -599,7 +599,7 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
          {"adapt_every", "max_passes", "indicator", "refine_threshold", "coarsen_tolerance",
           "coarsen_indicator_fraction", "stress_floor", "min_steps_between_changes",
           "max_active_elements", "max_level", "balance", "tolerance", "initial_adaptation",
-          "in_step_refinement", "full_resolution_fraction", "coarsen_budget"})
+          "in_step_refinement", "full_resolution_fraction", "coarsen_budget", "cut"})
       if (hierarchy.has(key))
         scene.ignored_keys.push_back(std::string("hierarchy.") + key +
                                      ": mode \"full\" does not adapt (ignored)");
