@@ -531,6 +531,16 @@ TEST(CliEndToEnd, KeysTheRunDoesNotUseAreWarnedAbout) {
             "strata: warning: scene.json: hierarchy.max_active_elements: mode \"full\" does not "
             "adapt (ignored)\nstrata: warning: scene.json: hierarchy.tolerance: mode \"full\" does "
             "not adapt (ignored)\n");
+  // A duration shorter than one step.
+  scene.erase("hierarchy");
+  scene["solver"] = json::parse(R"({"mode": "dynamic", "dt": 0.01, "duration": 0.004})");
+  write_scene(folder, scene);
+  result = run_strata("run scene.json -q", folder.path());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(
+      result.err,
+      "strata: warning: scene.json: solver.duration: 0.004 s is shorter than solver.dt 0.01 s "
+      "(the run takes one step of dt)\n");
 }
 
 TEST(CliEndToEnd, OutputFolderAndProgressFileProblemsAreBadInput) {

@@ -122,6 +122,16 @@ TEST(CliHierarchy, BadHierarchyKeysNameTheKey) {
   EXPECT_THAT(result.err, HasSubstr("hierarchy.level: is 2, deeper than max_level 1"));
   EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
 
+  // A budget below the roots is run, and warned about.
+  scene = slab_scene("adaptive");
+  scene["hierarchy"]["max_active_elements"] = 10;
+  write_text(folder.path() / "budget.json", scene.dump());
+  result = run_strata("run budget.json --quiet", folder.path());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_THAT(result.err,
+              HasSubstr("hierarchy.max_active_elements: 10 is below the 96 roots (the cut cannot "
+                        "refine)"));
+
   scene = slab_scene("adaptive");
   scene["hierarchy"]["refine_threshold"] = -1;
   write_text(folder.path() / "threshold.json", scene.dump());

@@ -580,6 +580,12 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
                                      ": applies to dynamic runs only (ignored)");
     if (dynamic && solver.has("load_steps"))
       scene.ignored_keys.push_back("solver.load_steps: applies to static runs only (ignored)");
+    if (dynamic && scene.solver.duration < scene.solver.dt * (1.0 - 1e-9)) {
+      std::ostringstream warning;
+      warning << "solver.duration: " << scene.solver.duration << " s is shorter than solver.dt "
+              << scene.solver.dt << " s (the run takes one step of dt)";
+      scene.ignored_keys.push_back(warning.str());
+    }
   }
   if (top.has("output")) {
     scene.output = parse_output(top.at("output"));

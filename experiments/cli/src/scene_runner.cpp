@@ -435,6 +435,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   summary.stable_dt_estimate = simulation->stable_dt_estimate();
   std::vector<RootPoint> probe_roots;
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive()) {
+    const Index budget = adaptive->settings().criteria.max_active_elements;
+    if (adaptive->settings().mode == HierarchyMode::adaptive && budget > 0 &&
+        budget < adaptive->tree().num_roots())
+      std::cerr << "strata: warning: " << scene.file.string()
+                << ": hierarchy.max_active_elements: " << budget << " is below the "
+                << adaptive->tree().num_roots() << " roots (the cut cannot refine)\n";
     try {
       probe_roots =
           adaptive->locate(probe_points, "output.probes", kProbeToleranceFactor * diagonal);
