@@ -712,6 +712,11 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
       m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
   if (calibration_target > 0.0) state.tolerance_scale = m_settings.tolerance / calibration_target;
   if (!coarsen && (!refine || within_tolerance)) return {};
+  // In-step refinement marks against coarsen_budget · τ, the margin merges keep: a motion whose
+  // estimate creeps up (a soft body sagging) would otherwise trip the test again a few steps
+  // later, and every trip redoes a step.
+  if (refine && !coarsen && !is_static(m_solver) && calibration_target <= 0.0)
+    state.tolerance_scale = m_estimate_scale / m_settings.coarsen_budget;
   fields = sim.model().tet_fields(sim.positions());
   // No merges while a load with an amplitude is still growing: the estimate of the current state
   // cannot see a load that is still to come, and merges made where it will act would meet it on
