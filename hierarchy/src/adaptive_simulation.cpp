@@ -121,6 +121,11 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
   if (!(settings.coarsen_budget > 0.0 && settings.coarsen_budget <= 1.0))
     throw InputError(where + ".coarsen_budget: must be in (0, 1]");
   validate_refinement_settings(settings.criteria, where);
+  if (settings.mode == HierarchyMode::adaptive && settings.criteria.max_level >= 0 &&
+      settings.level > settings.criteria.max_level)
+    throw InputError(where + ".level: is " + std::to_string(settings.level) +
+                     ", deeper than max_level " + std::to_string(settings.criteria.max_level) +
+                     " (the cut starts where refinement may not reach)");
   if (settings.mode == HierarchyMode::precomputed && !settings.precomputed)
     throw InputError(where + ".cut: mode \"precomputed\" needs a precomputed cut");
 }
@@ -440,6 +445,19 @@ void AdaptiveSimulation::make_dirichlet_exact() {
   }
 }
 
+bool AdaptiveSimulation::cut_can_refine() const {
+  if (!m_cut_can_refine) {
+    const int deepest = max_refine_level();
+    m_cut_can_refine = false;
+    for (const NodeId n : m_cut->nodes())
+      if (m_tree->level(n) < deepest && (!is_explicit(m_solver) || children_stable(n))) {
+        m_cut_can_refine = true;
+        break;
+      }
+  }
+  return *m_cut_can_refine;
+}
+
 bool AdaptiveSimulation::children_stable(NodeId n) const {
   // The eight children as a mesh of their own: its lumped masses are at most those of the
   // children in any cut, so its estimate is a lower bound of theirs (refusal errs on the safe
@@ -472,6 +490,7 @@ bool AdaptiveSimulation::stable_on_their_own(const std::vector<Matrix3x4d>& tets
 
 SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   m_estimate_valid = false;
+  m_cut_can_refine.reset();
   m_constrained = std::make_unique<ConstrainedCut>(flatten_cut(*m_cut));
   const FlatTreeMesh& flat = m_constrained->flat;
   const HangingConstraints& constraints = m_constrained->constraints;
@@ -544,6 +563,7 @@ void AdaptiveSimulation::advance_step() {
   if (adapting() && is_static(m_solver)) {
     // Solve–mark–refine: re-solve the same load factor on each refined cut.
     int passes = 0;
+    bool calibrated = false;
     for (int pass = 0; pass < m_settings.max_passes && adapting(); ++pass) {
       bool changed = adapt(pass, true, false);
       if (!changed && passes == 0 && m_estimates_error && calibration_due()) {
@@ -551,6 +571,7 @@ void AdaptiveSimulation::advance_step() {
         // reaching the tolerance: a pass against a fraction of it measures it again.
         changed = adapt(pass, true, false, kCalibrationFraction * m_estimate.relative_error);
         if (changed) ++m_report.calibration_passes;
+        calibrated = changed;
       }
       if (!changed) break;
       ++passes;
@@ -564,8 +585,10 @@ void AdaptiveSimulation::advance_step() {
       m_stepping_seconds += seconds_since(solve_start);
       if (m_estimates_error) measure_estimate(refined_estimate, m_simulation->positions(), carried);
     }
-    // Every pass refined: the load step's last solve was not judged again.
-    if (passes == m_settings.max_passes && adapting()) ++m_report.steps_out_of_passes;
+    // Every pass refined: the load step's last solve was not judged again (a calibration pass
+    // refines a load step already within the tolerance).
+    if (passes == m_settings.max_passes && adapting() && !calibrated)
+      ++m_report.steps_out_of_passes;
     // The baseline of the next calibration: the cut the passes ended on, or a cut no pass has
     // measured yet (the first load step's, or one the merges between load steps changed).
     if (m_estimates_error && (passes > 0 || m_calibrated_shares.size() == 0))
@@ -712,6 +735,12 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
       m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
   if (calibration_target > 0.0) state.tolerance_scale = m_settings.tolerance / calibration_target;
   if (!coarsen && (!refine || within_tolerance)) return {};
+  // A cut none of whose tets may refine (max_level, the explicit step limit) asks the controller
+  // for nothing it could do; the step is counted instead.
+  if (!coarsen && !cut_can_refine()) {
+    ++m_report.steps_unrefinable;
+    return {};
+  }
   // In-step refinement marks against coarsen_budget · τ, the margin merges keep: a motion whose
   // estimate creeps up (a soft body sagging) would otherwise trip the test again a few steps
   // later, and every trip redoes a step.

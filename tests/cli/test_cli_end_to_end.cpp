@@ -442,6 +442,12 @@ TEST(CliEndToEnd, OverflowsHugeMeshesAndControlCharactersGiveOneLineBadInputErro
   EXPECT_EQ(result.err,
             "strata: error: huge.json: line 1, column 45: number overflow parsing '1e400' (not a "
             "finite double)\n");
+  // Found as a number, not in a string or inside another number before it.
+  write_text(folder.path() / "later.json",
+             "{\"name\": \"1e309\", \"x\": 0.001e309,\n  \"mesh\": [\n    1e309]}");
+  EXPECT_EQ(run_strata("run later.json", folder.path()).err,
+            "strata: error: later.json: line 3, column 5: number overflow parsing '1e309' (not a "
+            "finite double)\n");
   // Finite values whose products overflow: the weight, or the stiffness.
   json scene = bar_scene();
   scene["gravity"] = {0, 0, -1e300};

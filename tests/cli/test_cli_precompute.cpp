@@ -131,7 +131,8 @@ TEST(CliPrecompute, BadInputGetsOneLineErrors) {
       folder,
       "run train.json -q --set hierarchy.mode='\"full\"' --set hierarchy.cut='\"cut.json\"'");
   EXPECT_EQ(full.exit_code, 0) << full.err;
-  EXPECT_THAT(full.err, HasSubstr("hierarchy.cut: mode \"full\" does not adapt (ignored)"));
+  EXPECT_THAT(full.err,
+              HasSubstr("hierarchy.cut: mode \"full\" plays back no precomputed cut (ignored)"));
   EXPECT_THAT(error("run other.json -q" + precomputed + " --set hierarchy.cut='\"cut.json\"'"),
               HasSubstr("hierarchy.cut (cut.json): made for a coarse mesh of 50 vertices"));
   EXPECT_THAT(error("run train.json -q" + precomputed + " --set hierarchy.cut='\"none.json\"'"),

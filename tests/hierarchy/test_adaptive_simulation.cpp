@@ -408,6 +408,19 @@ TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
                          Vector3d::Zero(), settings);
   run(sim);
   EXPECT_EQ(sim.cut().finest_level(), 0);
+  // The error-controlled defaults: over the tolerance on a cut no tet of which may refine, the
+  // controller is not asked at all; each such decision is counted.
+  HierarchySettings defaults;
+  defaults.levels = 2;
+  AdaptiveSimulation controlled(slab.coarse, defaults, rubber(), slab.fixed, slab.loads,
+                                std::nullopt, Vector3d::Zero(), settings);
+  run(controlled);
+  EXPECT_EQ(controlled.cut().finest_level(), 0);
+  const ToleranceReport& report = controlled.tolerance_report();
+  EXPECT_GT(report.steps_over_tolerance, 0);
+  EXPECT_EQ(report.steps_unrefinable, report.steps_over_tolerance);
+  // Only the initial adaptation's one decision refused (each root once), none of the steps'.
+  EXPECT_LE(report.refused_refinements, slab.coarse.tets.rows());
   // With a small enough step the same scene refines.
   settings.dt = 0.2 * coarse_dt;
   settings.duration = 20 * settings.dt;

@@ -43,8 +43,8 @@ OutputFolder::OutputFolder(const std::filesystem::path& folder)
   if (error)
     throw InputError("output folder '" + folder.string() + "': cannot create it (" +
                      error.message() + ")");
-  const std::filesystem::path lock = folder / ".strata.lock";
-  m_lock = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  m_lock_path = folder / ".strata.lock";
+  m_lock = ::open(m_lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (m_lock < 0)
     throw InputError("output folder '" + folder.string() + "': cannot write in it (" +
                      std::strerror(errno) + ")");
@@ -57,13 +57,14 @@ OutputFolder::OutputFolder(const std::filesystem::path& folder)
 }
 
 OutputFolder::~OutputFolder() {
-  if (m_lock >= 0) ::close(m_lock);  // closing releases the lock
-  // A run that failed before writing anything leaves no folder it created behind.
-  if (m_created && std::uncaught_exceptions() > m_exceptions) {
+  // A run that failed before writing anything leaves no folder it created behind: the lock file
+  // and the folder (only if empty) go while the lock is still held.
+  if (m_lock >= 0 && m_created && std::uncaught_exceptions() > m_exceptions) {
     std::error_code error;
-    std::filesystem::remove(m_folder / ".strata.lock", error);
-    std::filesystem::remove(m_folder, error);  // only if empty
+    std::filesystem::remove(m_lock_path, error);
+    std::filesystem::remove(m_folder, error);
   }
+  if (m_lock >= 0) ::close(m_lock);  // closing releases the lock
 }
 
 std::string format_double(double value) {

@@ -1,6 +1,7 @@
 #include "strata/app/scene_parser.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -425,6 +426,39 @@ SceneKeyError::SceneKeyError(const std::string& file, std::string key_path, cons
       m_key_path(std::move(key_path)),
       m_unknown_key(unknown_key) {}
 
+namespace {
+
+/// Where the number `literal` stands in the JSON text `content` (outside strings, as a whole
+/// number), or npos.
+std::size_t find_number(const std::string& content, const std::string& literal) {
+  const auto part_of_number = [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == 'E' ||
+           c == '+' || c == '-';
+  };
+  bool in_string = false;
+  for (std::size_t i = 0; i < content.size(); ++i) {
+    const char c = content[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // the escaped character
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      continue;
+    }
+    if (content.compare(i, literal.size(), literal) == 0 &&
+        (i == 0 || !part_of_number(content[i - 1])) &&
+        (i + literal.size() == content.size() || !part_of_number(content[i + literal.size()])))
+      return i;
+  }
+  return std::string::npos;
+}
+
+}  // namespace
+
 nlohmann::json read_json_file(const std::filesystem::path& file) {
   std::error_code error_code;
   if (std::filesystem::is_directory(file, error_code))
@@ -460,13 +494,11 @@ nlohmann::json read_json_file(const std::filesystem::path& file) {
     const std::string what = error.what();
     const std::size_t start = what.find("] ");
     std::string where;
-    // The number's place in the file: the quoted literal of the message, found in the text.
     const std::size_t open = what.find('\''), close = what.rfind('\'');
     if (open != std::string::npos && close > open + 1) {
-      const std::string literal = what.substr(open + 1, close - open - 1);
-      const std::string content = text.str();
-      const std::size_t at = content.find(literal);
+      const std::size_t at = find_number(text.str(), what.substr(open + 1, close - open - 1));
       if (at != std::string::npos) {
+        const std::string content = text.str();
         const std::size_t line_start = content.rfind('\n', at);
         const auto line = 1 + std::count(content.begin(), content.begin() + at, '\n');
         const std::size_t column = at - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
@@ -601,14 +633,17 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
     if (hierarchy.has("level"))
       scene.ignored_keys.push_back(
           "hierarchy.level: mode \"full\" runs on the finest level (ignored)");
-    for (const char* key :
-         {"adapt_every", "max_passes", "indicator", "refine_threshold", "coarsen_tolerance",
-          "coarsen_indicator_fraction", "stress_floor", "min_steps_between_changes",
-          "max_active_elements", "max_level", "balance", "tolerance", "initial_adaptation",
-          "in_step_refinement", "full_resolution_fraction", "coarsen_budget", "cut"})
+    for (const char* key : {"adapt_every", "max_passes", "indicator", "refine_threshold",
+                            "coarsen_tolerance", "coarsen_indicator_fraction", "stress_floor",
+                            "min_steps_between_changes", "max_active_elements", "max_level",
+                            "balance", "tolerance", "initial_adaptation", "in_step_refinement",
+                            "full_resolution_fraction", "coarsen_budget", "finest_contact_points"})
       if (hierarchy.has(key))
         scene.ignored_keys.push_back(std::string("hierarchy.") + key +
                                      ": mode \"full\" does not adapt (ignored)");
+    if (hierarchy.has("cut"))
+      scene.ignored_keys.push_back(
+          "hierarchy.cut: mode \"full\" plays back no precomputed cut (ignored)");
   }
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {

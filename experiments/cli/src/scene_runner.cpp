@@ -238,6 +238,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
   block["tolerance_met"] = finished && report.steps_over_tolerance == 0;
   block["steps_over_tolerance"] = report.steps_over_tolerance;
   block["steps_out_of_passes"] = report.steps_out_of_passes;
+  block["steps_unrefinable"] = report.steps_unrefinable;
   block["estimate_scale"] = report.estimate_scale;
   block["refused_refinements"] = report.refused_refinements;
   block["redone_steps"] = report.redone_steps;
@@ -437,10 +438,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive()) {
     const Index budget = adaptive->settings().criteria.max_active_elements;
     if (adaptive->settings().mode == HierarchyMode::adaptive && budget > 0 &&
-        budget < adaptive->tree().num_roots())
+        budget < adaptive->tree().num_roots()) {
+      log.flush();
       std::cerr << "strata: warning: " << scene.file.string()
                 << ": hierarchy.max_active_elements: " << budget << " is below the "
                 << adaptive->tree().num_roots() << " roots (the cut cannot refine)\n";
+    }
     try {
       probe_roots =
           adaptive->locate(probe_points, "output.probes", kProbeToleranceFactor * diagonal);
@@ -627,6 +630,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
         std::cerr << "; " << report.refused_refinements
                   << " refinements refused by max_level, max_active_elements, the explicit step "
                      "limit or hysteresis";
+        if (report.steps_unrefinable > 0)
+          std::cerr << "; " << report.steps_unrefinable
+                    << " decisions on a cut no tet of which may refine (max_level or the explicit "
+                       "step limit)";
         if (report.steps_out_of_passes > 0)
           std::cerr << "; " << report.steps_out_of_passes << " steps still refining after all "
                     << adaptive->settings().max_passes << " hierarchy.max_passes";

@@ -102,7 +102,9 @@ struct HierarchySettings {
   /// With the recovery estimate (an error-estimating indicator): the merges of one change are
   /// kept to those whose predicted estimate stays within coarsen_budget · tolerance
   /// (merges_within_budget), so that coarsening alone does not lift the run over its tolerance;
-  /// ∈ (0, 1].
+  /// and a dynamic run's in-step refinement, triggered by an estimate over the tolerance, marks
+  /// against coarsen_budget · tolerance, so that an estimate that creeps up does not trip the
+  /// test again a few steps later; ∈ (0, 1].
   double coarsen_budget = 0.8;
   /// With obstacles and no `contact_surface`: the finest level's boundary vertices
   /// (finest_boundary_points), embedded in each cut, are the contact points in place of the cut's
@@ -196,6 +198,9 @@ struct ToleranceReport {
   /// Accepted steps (static: load steps) whose every pass of hierarchy.max_passes refined, so that
   /// the last attempt was not judged again.
   long steps_out_of_passes = 0;
+  /// Decisions over the tolerance on a cut none of whose tets may refine (every one at max_level
+  /// or, with an explicit integrator, past the stable step limit): refinement is not asked for.
+  long steps_unrefinable = 0;
   long calibration_passes = 0;         ///< static: passes made to measure a grown estimate again
   double redo_seconds = 0.0;           ///< wall time of the discarded attempts [s]
   int initial_refinements = 0;         ///< nodes refined by the initial adaptation
@@ -318,6 +323,10 @@ class AdaptiveSimulation final : public SimulationRun {
   RecoveryEstimate estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
+  /// Whether an active tet of the cut may refine: below max_refine_level() and, with an explicit
+  /// integrator, with children_stable(); computed once per cut.
+  bool cut_can_refine() const;
+  mutable std::optional<bool> m_cut_can_refine;
   /// Whether solver.dt is within the stable-step estimate of `tets` (Bey-ordered positions) as a
   /// mesh of their own.
   bool stable_on_their_own(const std::vector<Matrix3x4d>& tets) const;

@@ -55,7 +55,8 @@ struct CutState {
   const RecoveryEstimate* recovery_estimate = nullptr;
   /// The decision's tolerance is the indicator's divided by this (≥ 1): a static run whose
   /// refinement passes measured changes larger than the estimate of the cuts they refined judges
-  /// later decisions by that ratio (AdaptiveSimulation, README "Error control").
+  /// later decisions by that ratio (AdaptiveSimulation, README "Error control"), and a dynamic
+  /// run's in-step refinement marks against coarsen_budget · tolerance (divided by it as well).
   double tolerance_scale = 1.0;
 };
 

@@ -27,7 +27,8 @@ class OutputFolder {
  public:
   /// Creates `folder` if needed and takes it; throws InputError if it cannot be created or
   /// another run holds it. A folder it created is removed again if it is destroyed by an
-  /// exception while empty (a run that failed before writing any output).
+  /// exception while it holds nothing but the lock file (a run that failed before writing any
+  /// output); folders above it that it created stay.
   explicit OutputFolder(const std::filesystem::path& folder);
   ~OutputFolder();
   OutputFolder(const OutputFolder&) = delete;
@@ -35,6 +36,7 @@ class OutputFolder {
 
  private:
   std::filesystem::path m_folder;
+  std::filesystem::path m_lock_path;
   int m_exceptions = 0;  ///< uncaught exceptions at construction
   bool m_created = false;
   int m_lock = -1;
