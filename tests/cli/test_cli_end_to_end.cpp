@@ -508,21 +508,22 @@ TEST(CliEndToEnd, DuplicateKeysFoldersAndFilesAreNamedInTheError) {
 
 TEST(CliEndToEnd, KeysTheRunDoesNotUseAreWarnedAbout) {
   TempFolder folder;
+  // The run's stderr: warnings only, and a run that exits 0.
+  const auto warnings = [&](const json& scene) {
+    write_scene(folder, scene);
+    const CliResult result = run_strata("run scene.json -q", folder.path());
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return result.err;
+  };
   json scene = bar_scene();  // static
   scene["solver"]["dt"] = 0.01;
-  write_scene(folder, scene);
-  CliResult result = run_strata("run scene.json -q", folder.path());
-  EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_EQ(result.err,
+  EXPECT_EQ(warnings(scene),
             "strata: warning: scene.json: solver.dt: applies to dynamic runs only (ignored)\n");
   scene = bar_scene();
   scene["solver"] =
       json::parse(R"({"mode": "dynamic", "dt": 0.01, "duration": 0.01, "load_steps": 4})");
   scene["hierarchy"] = {{"levels", 1}, {"mode", "full"}, {"level", 0}};
-  write_scene(folder, scene);
-  result = run_strata("run scene.json -q", folder.path());
-  EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_EQ(result.err,
+  EXPECT_EQ(warnings(scene),
             "strata: warning: scene.json: solver.load_steps: applies to static runs only "
             "(ignored)\nstrata: warning: scene.json: hierarchy.level: mode \"full\" runs on the "
             "finest level (ignored)\n");
@@ -530,21 +531,15 @@ TEST(CliEndToEnd, KeysTheRunDoesNotUseAreWarnedAbout) {
   scene["solver"].erase("load_steps");
   scene["hierarchy"] = {
       {"levels", 1}, {"mode", "full"}, {"tolerance", 0.05}, {"max_active_elements", 100}};
-  write_scene(folder, scene);
-  result = run_strata("run scene.json -q", folder.path());
-  EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_EQ(result.err,
+  EXPECT_EQ(warnings(scene),
             "strata: warning: scene.json: hierarchy.max_active_elements: mode \"full\" does not "
             "adapt (ignored)\nstrata: warning: scene.json: hierarchy.tolerance: mode \"full\" does "
             "not adapt (ignored)\n");
   // A duration shorter than one step.
   scene.erase("hierarchy");
   scene["solver"] = json::parse(R"({"mode": "dynamic", "dt": 0.01, "duration": 0.004})");
-  write_scene(folder, scene);
-  result = run_strata("run scene.json -q", folder.path());
-  EXPECT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(
-      result.err,
+      warnings(scene),
       "strata: warning: scene.json: solver.duration: 0.004 s is shorter than solver.dt 0.01 s "
       "(the run takes one step of dt)\n");
 }

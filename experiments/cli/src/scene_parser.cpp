@@ -496,9 +496,9 @@ nlohmann::json read_json_file(const std::filesystem::path& file) {
     std::string where;
     const std::size_t open = what.find('\''), close = what.rfind('\'');
     if (open != std::string::npos && close > open + 1) {
-      const std::size_t at = find_number(text.str(), what.substr(open + 1, close - open - 1));
+      const std::string content = text.str();
+      const std::size_t at = find_number(content, what.substr(open + 1, close - open - 1));
       if (at != std::string::npos) {
-        const std::string content = text.str();
         const std::size_t line_start = content.rfind('\n', at);
         const auto line = 1 + std::count(content.begin(), content.begin() + at, '\n');
         const std::size_t column = at - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
@@ -629,21 +629,15 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
   if (top.has("hierarchy"))
     scene.hierarchy = detail::parse_hierarchy(top.at("hierarchy"), file.parent_path());
   if (scene.hierarchy && scene.hierarchy->mode == HierarchyMode::full) {
-    const SceneValue hierarchy = top.at("hierarchy");
-    if (hierarchy.has("level"))
-      scene.ignored_keys.push_back(
-          "hierarchy.level: mode \"full\" runs on the finest level (ignored)");
-    for (const char* key : {"adapt_every", "max_passes", "indicator", "refine_threshold",
-                            "coarsen_tolerance", "coarsen_indicator_fraction", "stress_floor",
-                            "min_steps_between_changes", "max_active_elements", "max_level",
-                            "balance", "tolerance", "initial_adaptation", "in_step_refinement",
-                            "full_resolution_fraction", "coarsen_budget", "finest_contact_points"})
-      if (hierarchy.has(key))
-        scene.ignored_keys.push_back(std::string("hierarchy.") + key +
-                                     ": mode \"full\" does not adapt (ignored)");
-    if (hierarchy.has("cut"))
-      scene.ignored_keys.push_back(
-          "hierarchy.cut: mode \"full\" plays back no precomputed cut (ignored)");
+    // Every key but levels and mode is one of adaptation (parse_hierarchy refuses unknown keys).
+    for (const auto& item : top.at("hierarchy").json().items()) {
+      const std::string& key = item.key();
+      if (key == "levels" || key == "mode") continue;
+      const char* reason = key == "level" ? "runs on the finest level"
+                           : key == "cut" ? "plays back no precomputed cut"
+                                          : "does not adapt";
+      scene.ignored_keys.push_back("hierarchy." + key + ": mode \"full\" " + reason + " (ignored)");
+    }
   }
   if (scene.solver.mode == SimulationMode::static_equilibrium && scene.fixed.empty() &&
       scene.prescribed.empty()) {
