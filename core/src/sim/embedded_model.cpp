@@ -1,5 +1,6 @@
 #include "strata/core/sim/embedded_model.hpp"
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -220,100 +221,20 @@ void EmbeddedElasticModel::stiffness(ConstRef<VectorXd> q, SparseMatrixd& K,
   });
   m_model->stiffness_into(expand(q), project_psd,
                           {values, m_offsets.data(), m_in_layer.data(), m_layer_values.data()});
-  // The layer's blocks into their targets, range by range of K's values (each range's additions
-  // in the order of the serial pass).
+  // The layer's blocks into their targets, DOF vertex by DOF vertex (each column of K_q's values
+  // receives its additions in a fixed order, whatever the thread count).
   const double* source = m_layer_values.data();
   const LayerAddition* additions = m_layer_additions.data();
-  tbb::parallel_for(Index(0), static_cast<Index>(m_range_begin.size()) - 1, [&](Index range) {
-    for (Index k = m_range_begin[range]; k < m_range_begin[range + 1]; ++k) {
-      const LayerAddition& addition = additions[k];
-      const double* block = source + 3 * Index(addition.block);
-      for (int i = 0; i < 3; ++i)
-        values[addition.target + i] += addition.weight * block[i];
-    }
-  });
-}
-
-void EmbeddedElasticModel::group_layer_additions(const FillVector<int>& block_targets,
-                                                 const FillVector<WeightedTarget>& weighted) {
-  const auto num_blocks = static_cast<Index>(block_targets.size());
-  m_num_layer_blocks = num_blocks;
-  // Fixed chunks of blocks (the additions of chunk c come before those of chunk c + 1 in every
-  // range) and slices of K_q's values 2^shift long (at most kTargetBins of them); a range is a run
-  // of slices.
-  constexpr Index kTargetBins = 512;
-  constexpr Index kRanges = 16;
-  int shift = 0;
-  while ((m_pattern.nonZeros() >> shift) >= kTargetBins)
-    ++shift;
-  const Index num_bins = (m_pattern.nonZeros() >> shift) + 1;
-  const Index num_chunks = std::clamp<Index>(num_blocks / 2048, 1, 128);
-  const auto chunk_begin = [&](Index c) { return num_blocks * c / num_chunks; };
-  const auto bin_of = [shift](int target) { return static_cast<Index>(target >> shift); };
-  // The first weighted entry of each chunk.
-  std::vector<Index> first_weighted(num_chunks + 1, 0);
-  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
-    Index count = 0;
-    for (Index g = chunk_begin(c); g < chunk_begin(c + 1); ++g)
-      if (block_targets[g] < 0) count += ~block_targets[g];
-    first_weighted[c + 1] = count;
-  });
-  for (Index c = 0; c < num_chunks; ++c)
-    first_weighted[c + 1] += first_weighted[c];
-  // Visits the additions of chunk c in serial order: visit(block, target, weight).
-  const auto for_each_addition = [&](Index c, auto&& visit) {
-    const WeightedTarget* next = weighted.data() + first_weighted[c];
-    for (Index g = chunk_begin(c); g < chunk_begin(c + 1); ++g) {
-      const int target = block_targets[g];
-      if (target >= 0) {
-        visit(g, target, 1.0);
-        continue;
-      }
-      for (int n = 0; n < ~target; ++n, ++next)
-        visit(g, next->target, next->weight);
-    }
-  };
-  std::vector<Index> counts(num_chunks * num_bins, 0);  // additions per chunk and slice
-  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
-    Index* chunk_counts = &counts[c * num_bins];
-    for_each_addition(c, [&](Index, int target, double) { ++chunk_counts[bin_of(target)]; });
-  });
-  std::vector<Index> bin_total(num_bins, 0);
-  for (Index c = 0; c < num_chunks; ++c)
-    for (Index b = 0; b < num_bins; ++b)
-      bin_total[b] += counts[c * num_bins + b];
-  Index total = 0;
-  for (const Index n : bin_total)
-    total += n;
-  // Slices to ranges: range r ends at the first slice where the additions so far reach
-  // total · (r + 1) / kRanges.
-  std::vector<Index> range_of_bin(num_bins);
-  for (Index b = 0, range = 0, so_far = 0; b < num_bins; ++b) {
-    range_of_bin[b] = range;
-    so_far += bin_total[b];
-    while (range + 1 < kRanges && so_far * kRanges >= total * (range + 1))
-      ++range;
-  }
-  // Where each chunk's additions of each range go: ranges in order, chunks in order within one.
-  std::vector<Index> position(kRanges * num_chunks, 0);
-  for (Index c = 0; c < num_chunks; ++c)
-    for (Index b = 0; b < num_bins; ++b)
-      position[range_of_bin[b] * num_chunks + c] += counts[c * num_bins + b];
-  m_range_begin.assign(kRanges + 1, 0);
-  for (Index k = 0, start = 0; k < kRanges * num_chunks; ++k) {
-    if (k % num_chunks == 0) m_range_begin[k / num_chunks] = start;
-    const Index n = position[k];
-    position[k] = start;
-    start += n;
-  }
-  m_range_begin[kRanges] = total;
-  m_layer_additions.resize(total);
-  tbb::parallel_for(Index(0), num_chunks, [&](Index c) {
-    for_each_addition(c, [&](Index g, int target, double weight) {
-      Index& at = position[range_of_bin[bin_of(target)] * num_chunks + c];
-      m_layer_additions[at++] = {static_cast<int>(g), target, weight};
-    });
-  });
+  tbb::parallel_for(tbb::blocked_range<Index>(0, m_num_dof_vertices, 256),
+                    [&](const tbb::blocked_range<Index>& columns) {
+                      for (Index k = m_column_begin[columns.begin()];
+                           k < m_column_begin[columns.end()]; ++k) {
+                        const LayerAddition& addition = additions[k];
+                        const double* block = source + 3 * Index(addition.block);
+                        for (int i = 0; i < 3; ++i)
+                          values[addition.target + i] += addition.weight * block[i];
+                      }
+                    });
 }
 
 void EmbeddedElasticModel::build_reduced_pattern() {
@@ -375,8 +296,6 @@ void EmbeddedElasticModel::build_reduced_pattern() {
   // The scalar pattern of K_q and the assembly plan (element offsets, the layer's targets) are
   // built side by side: neither reads what the other writes.
   SparseMatrixd pattern;
-  FillVector<int> block_targets;
-  FillVector<WeightedTarget> weighted_targets;
   const auto plan = [&] {
     // Element block offsets, vertex by vertex: for each tet of w (local corner b), the blocks (a,
     // b) of its corners a in K_q's values (a direct tet: w's DOF vertex's list) or in the layer's
@@ -423,88 +342,48 @@ void EmbeddedElasticModel::build_reduced_pattern() {
       for (const int q : dof_list)
         dof_slot[q] = -1;
     });
-
-    // The targets of the layer's blocks, in the order of its values: the columns (w, j), their
-    // blocks v, then the entries C_va, C_wb. A block of two direct vertices adds to one reduced
-    // block directly.
-    std::vector<Index> first_weighted(num_mesh_vertices + 1, 0);
-    tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
-      const Index w_entries = row_outer[w + 1] - row_outer[w];
+  };
+  // The layer's additions, DOF vertex b by DOF vertex: for each column j of b's block column, the
+  // mesh vertices w of C's column b (ascending), their layer blocks (v, w) (v ascending) and the
+  // entries C_va of v's row, adding C_va C_wb (v, w) to K_q's block (a, b). Each value of K_q so
+  // receives its additions in the order of the layer's blocks.
+  const auto additions = [&] {
+    const Index n = m_num_dof_vertices;
+    m_column_begin.assign(n + 1, 0);
+    tbb::parallel_for(Index(0), n, [&](Index b) {
       Index count = 0;
-      for (const int v : layer[w])
-        if (direct_dof[v] < 0 || direct_dof[w] < 0)
-          count += (row_outer[v + 1] - row_outer[v]) * w_entries;
-      first_weighted[w + 1] = 3 * count;
+      for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w)
+        for (const int v : layer[w.row()])
+          count += row_outer[v + 1] - row_outer[v];
+      m_column_begin[b + 1] = 3 * count;
     });
-    for (Index w = 0; w < num_mesh_vertices; ++w)
-      first_weighted[w + 1] += first_weighted[w];
-    if (first_weighted[num_mesh_vertices] > std::numeric_limits<int>::max())
-      throw InputError("embedding: reduced stiffness matrix exceeds 2^31 entries");
-    block_targets.resize(3 * layer.indices.size());
-    weighted_targets.resize(first_weighted[num_mesh_vertices]);
-    // Per thread: the slot of each DOF vertex in the lists of `blocks` of w's row entries (up to
-    // kMarked of them; −1 elsewhere), and the slots of one vertex's targets.
-    constexpr int kMarked = 4;
+    for (Index b = 0; b < n; ++b)
+      m_column_begin[b + 1] += m_column_begin[b];
+    m_layer_additions.resize(m_column_begin[n]);
     tbb::enumerable_thread_specific<std::vector<int>> slots_of(
-        [&] { return std::vector<int>(m_num_dof_vertices, -1); });
-    tbb::enumerable_thread_specific<std::vector<Index>> target_slots;
-    tbb::parallel_for(Index(0), num_mesh_vertices, [&](Index w) {
-      const std::span<const int> list = layer[w];
-      if (list.empty()) return;
-      // The DOF vertices b of w's row (one unless w hangs) and the slots in their lists.
-      const int first_b = row_outer[w];
-      const int num_b = row_outer[w + 1] - first_b;
-      const bool marked = num_b <= kMarked;
-      std::vector<int>& marks_of = slots_of.local();  // more arrays only once a vertex hangs
-      if (marked && marks_of.size() < num_b * std::size_t(m_num_dof_vertices))
-        marks_of.resize(num_b * std::size_t(m_num_dof_vertices), -1);
-      int* slot_of = marks_of.data();
-      if (marked)
-        for (int k = 0; k < num_b; ++k) {
-          const std::span<const int> b_list = blocks[row_inner[first_b + k]];
-          int* marks = slot_of + k * m_num_dof_vertices;
-          for (std::size_t i = 0; i < b_list.size(); ++i)
-            marks[b_list[i]] = static_cast<int>(i);
-        }
-      auto slot = [&](int a, int ib) -> Index {
-        if (marked) return slot_of[(ib - first_b) * m_num_dof_vertices + a];
-        const std::span<const int> b_list = blocks[row_inner[ib]];
-        return std::lower_bound(b_list.begin(), b_list.end(), a) - b_list.begin();
-      };
-      // The slots of the targets of every block (v, w), in the order (v, C_va, C_wb).
-      std::vector<Index>& slots = target_slots.local();
-      slots.clear();
-      for (const int v : list)
-        for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
-          for (int ib = first_b; ib < first_b + num_b; ++ib)
-            slots.push_back(slot(row_inner[ia], ib));
-      if (marked)
-        for (int k = 0; k < num_b; ++k) {
-          int* marks = slot_of + k * m_num_dof_vertices;
-          for (const int a : blocks[row_inner[first_b + k]])
-            marks[a] = -1;
-        }
-      // The layer's values are column by column (3w + j), each holding the blocks of `list`.
-      Index position = first_weighted[w];
+        [&] { return std::vector<int>(n, -1); });
+    tbb::parallel_for(Index(0), n, [&](Index b) {
+      std::vector<int>& slot = slots_of.local();
+      const std::span<const int> b_list = blocks[b];
+      for (std::size_t k = 0; k < b_list.size(); ++k)
+        slot[b_list[k]] = static_cast<int>(k);
+      LayerAddition* out = m_layer_additions.data() + m_column_begin[b];
       for (int j = 0; j < 3; ++j) {
-        const Index* next_slot = slots.data();
-        for (std::size_t k = 0; k < list.size(); ++k) {
-          const int v = list[k];
-          const Index block = block_column_start(layer, w, j) / 3 + static_cast<Index>(k);
-          if (direct_dof[v] >= 0 && direct_dof[w] >= 0) {
-            block_targets[block] =
-                static_cast<int>(block_column_start(blocks, direct_dof[w], j) + 3 * *next_slot++);
-            continue;
+        const Index column = block_column_start(blocks, b, j);
+        for (SparseMatrixd::InnerIterator w(m_C, b); w; ++w) {
+          const std::span<const int> list = layer[w.row()];
+          const Index first_block = block_column_start(layer, w.row(), j) / 3;
+          for (std::size_t k = 0; k < list.size(); ++k) {
+            const int v = list[k];
+            for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
+              *out++ = {static_cast<int>(first_block + static_cast<Index>(k)),
+                        static_cast<int>(column + 3 * slot[row_inner[ia]]),
+                        row_values[ia] * w.value()};
           }
-          const Index first = position;
-          for (int ia = row_outer[v]; ia < row_outer[v + 1]; ++ia)
-            for (int ib = row_outer[w]; ib < row_outer[w + 1]; ++ib)
-              weighted_targets[position++] = {
-                  static_cast<int>(block_column_start(blocks, row_inner[ib], j) + 3 * *next_slot++),
-                  row_values[ia] * row_values[ib]};
-          block_targets[block] = ~static_cast<int>(position - first);
         }
       }
+      for (const int a : b_list)
+        slot[a] = -1;
     });
   };
   tbb::parallel_invoke(
@@ -512,9 +391,9 @@ void EmbeddedElasticModel::build_reduced_pattern() {
         SparseMatrixd built = block_pattern(blocks, "embedding: reduced stiffness matrix");
         pattern.swap(built);  // Eigen's assignment from a named matrix would copy it
       },
-      plan);
+      plan, additions);
   m_pattern.swap(pattern);
-  group_layer_additions(block_targets, weighted_targets);
+  m_num_layer_blocks = 3 * static_cast<Index>(layer.indices.size());
 }
 
 }  // namespace strata

@@ -15,10 +15,10 @@
 /// vertices are DOF vertices (C rows e_q) adds its element stiffness straight to K_q in the mesh
 /// model's parallel pass; the tets that touch a hanging vertex (a thin layer where levels meet)
 /// assemble a mesh-level matrix of their own vertex blocks, each of whose blocks (v, w) then adds
-/// to the reduced blocks (a, b) with weight C_va C_wb. Those additions are grouped once per
-/// embedding into ranges of K_q's values, each range's in the order of the serial pass over the
-/// layer, and the ranges add in parallel: every value receives its additions in the serial order,
-/// so the result does not depend on the thread count.
+/// to the reduced blocks (a, b) with weight C_va C_wb. Those additions are listed once per
+/// embedding by the DOF vertex b whose block column they add to, each value's in the order of the
+/// layer's blocks, and the block columns add in parallel: every value receives its additions in
+/// one fixed order, so the result does not depend on the thread count.
 ///
 /// Requirements on C (checked, InputError): every row sums to 1 with non-negative entries
 /// (partition of unity: affine fields and rigid motions are reproduced exactly) and each DOF
@@ -80,25 +80,15 @@ class EmbeddedElasticModel {
   Index num_layer_tets() const { return m_num_layer_tets; }
 
  private:
-  /// A contribution of a layer block to the reduced stiffness through a hanging vertex (or any
-  /// weight ≠ 1): values[target + i] += weight · (the layer block's value i), i = 0, 1, 2.
-  struct WeightedTarget {
-    int target;
-    double weight;
-  };
   /// One addition of the layer's scatter: K_q's values[target + i] += weight · layer value
-  /// 3 · block + i, i = 0, 1, 2 (weight 1 for a block of two DOF vertices).
+  /// 3 · block + i, i = 0, 1, 2 (the weight C_va C_wb of the layer block (v, w) in K_q's block
+  /// (a, b)).
   struct LayerAddition {
     int block;
     int target;
     double weight;
   };
   void build_reduced_pattern();
-  /// m_layer_additions and m_range_begin from the layer blocks' targets: per block (3-value column
-  /// g, in order) the reduced value it adds to with weight 1 (≥ 0), or ~n (< 0): it adds through
-  /// the next n entries of `weighted`.
-  void group_layer_additions(const FillVector<int>& block_targets,
-                             const FillVector<WeightedTarget>& weighted);
 
   const ElasticModel* m_model;
   bool m_identity = true;
@@ -116,11 +106,11 @@ class EmbeddedElasticModel {
   FillVector<int> m_offsets;
   Index m_num_layer_tets = 0;
   /// The additions of the layer's blocks (3-value columns, values 3g … 3g + 2 of block g) to
-  /// K_q, grouped by consecutive ranges of K_q's values (with about equal numbers of additions):
-  /// range r's are [m_range_begin[r], m_range_begin[r + 1]) of m_layer_additions, in the order of
-  /// the serial pass (blocks ascending, each block's targets in the order C_va, C_wb).
+  /// K_q, by the DOF vertex b whose block column they add to: b's are [m_column_begin[b],
+  /// m_column_begin[b + 1]) of m_layer_additions, and each value's come in the order of the
+  /// layer's blocks.
   FillVector<LayerAddition> m_layer_additions;
-  std::vector<Index> m_range_begin{0};
+  std::vector<Index> m_column_begin{0};
   Index m_num_layer_blocks = 0;
   mutable FillVector<double> m_layer_values;  ///< the layer's mesh-level blocks
 };
