@@ -227,14 +227,14 @@ inline void prefetch_block_entries(const int* offsets, const double* values) {
 }
 
 /// Adds one tet's element stiffness (12 × 12, column-major) to the sparse values. `offsets` (48
-/// per tet): for vertex pair (a, b) and column c, offsets[12a + 3b + c] is the position of
+/// per tet): for vertex pair (a, b) and column c, offsets[12b + 3a + c] is the position of
 /// K(3a, 3b + c), with rows 3a + 1 and 3a + 2 following it.
 inline void scatter_element_stiffness(const double (&K)[12][12], const int* offsets,
                                       double* values) {
-  for (int a = 0; a < 4; ++a)
-    for (int b = 0; b < 4; ++b)
+  for (int b = 0; b < 4; ++b)
+    for (int a = 0; a < 4; ++a)
       for (int c = 0; c < 3; ++c) {
-        double* entry = values + offsets[12 * a + 3 * b + c];
+        double* entry = values + offsets[12 * b + 3 * a + c];
         const double* column = &K[3 * b + c][3 * a];
         entry[0] += column[0];
         entry[1] += column[1];

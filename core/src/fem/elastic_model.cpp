@@ -366,7 +366,7 @@ void ElasticModel::build_stiffness_pattern() const {
           slot[a] += neighbour < tet[a];
       for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 3; ++c)
-          m_block_offsets[48 * i + 12 * a + 3 * b + c] =
+          m_block_offsets[48 * i + 12 * b + 3 * a + c] =
               static_cast<int>(block_column_start(neighbours, tet[b], c)) + 3 * slot[a];
     }
   });
@@ -492,10 +492,10 @@ void ElasticModel::stiffness_into(ConstRef<VectorXd> x, bool project_psd,
         }
         const int* offsets = &scatter.offsets[48 * Index(i)];
         double* values = scatter_values(scatter, i);
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b)
+        for (int b = 0; b < 4; ++b)
+          for (int a = 0; a < 4; ++a)
             for (int c = 0; c < 3; ++c) {
-              double* entry = values + offsets[12 * a + 3 * b + c];
+              double* entry = values + offsets[12 * b + 3 * a + c];
               entry[0] += blocks[a][b](0, c);
               entry[1] += blocks[a][b](1, c);
               entry[2] += blocks[a][b](2, c);

@@ -334,7 +334,7 @@ void EmbeddedElasticModel::build_reduced_pattern() {
         int* offsets = all_offsets + 48 * Index(t);
         for (int a = 0; a < 4; ++a)
           for (int c = 0; c < 3; ++c)
-            offsets[12 * a + 3 * b + c] =
+            offsets[12 * b + 3 * a + c] =
                 static_cast<int>(start + 3 * slots[a] + c * column_length);
       }
       for (const int v : layer_list)

@@ -19,11 +19,12 @@
 namespace strata {
 
 /// Where `ElasticModel::stiffness_into` puts each tet's element stiffness. For tet i in the
-/// kernels' order (`sorted_tets()`), `offsets[48 i + 12 a + 3 b + c]` is the position of the entry
+/// kernels' order (`sorted_tets()`), `offsets[48 i + 12 b + 3 a + c]` is the position of the entry
 /// (row 3a, column 3b + c) of the element's 12 × 12 matrix for local vertices a, b; rows 3a + 1 and
-/// 3a + 2 follow it. The positions are in `values`, or in `second_values` for the tets with
-/// `in_second[i]` set (`in_second` may be null). Tets that share no vertex must have disjoint
-/// targets: the tets of one colour of the schedule are written concurrently.
+/// 3a + 2 follow it (the twelve offsets of local vertex b's columns lie together). The positions
+/// are in `values`, or in `second_values` for the tets with `in_second[i]` set (`in_second` may be
+/// null). Tets that share no vertex must have disjoint targets: the tets of one colour of the
+/// schedule are written concurrently.
 struct StiffnessScatter {
   double* values = nullptr;
   const int* offsets = nullptr;
