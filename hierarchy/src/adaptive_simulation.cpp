@@ -340,6 +340,7 @@ void AdaptiveSimulation::initial_adaptation() {
     CutState state{*m_tree,         m_constrained->flat,  solve->positions(), fields,
                    loads,           solve->vertex_mass(), m_material,         0,
                    &m_load_traction};
+    state.recovery_geometry = cut_geometry();
     state.solution_energy_scale = m_energy_floor;
     state.solution_displacement_scale = m_displacement_floor;
     state.tolerance_scale = m_estimate_scale;
@@ -445,6 +446,11 @@ void AdaptiveSimulation::make_dirichlet_exact() {
   }
 }
 
+const RecoveryGeometry* AdaptiveSimulation::cut_geometry() {
+  if (!m_cut_geometry) m_cut_geometry = recovery_geometry(m_constrained->flat.mesh);
+  return &*m_cut_geometry;
+}
+
 bool AdaptiveSimulation::cut_can_refine() const {
   if (!m_cut_can_refine) {
     const int deepest = max_refine_level();
@@ -491,6 +497,7 @@ bool AdaptiveSimulation::stable_on_their_own(const std::vector<Matrix3x4d>& tets
 SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   m_estimate_valid = false;
   m_cut_can_refine.reset();
+  m_cut_geometry.reset();
   m_constrained = std::make_unique<ConstrainedCut>(flatten_cut(*m_cut));
   const FlatTreeMesh& flat = m_constrained->flat;
   const HangingConstraints& constraints = m_constrained->constraints;
@@ -722,6 +729,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   const VectorXd loads = criteria_loads(sim);
   CutState state{*m_tree,           flat,       sim.positions(),  fields,          loads,
                  sim.vertex_mass(), m_material, sim.step_count(), &m_load_traction};
+  state.recovery_geometry = cut_geometry();
   state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
   state.solution_displacement_scale = std::max(m_displacement_scale, m_displacement_floor);
   state.tolerance_scale = m_estimate_scale;
@@ -959,6 +967,7 @@ RecoveryEstimate AdaptiveSimulation::estimate_error() {
     CutState state{*m_tree,    m_constrained->flat, sim.positions(),
                    fields,     m_mesh_external,     sim.vertex_mass(),
                    m_material, sim.step_count(),    &m_load_traction};
+    state.recovery_geometry = cut_geometry();
     state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
     state.solution_displacement_scale = std::max(m_displacement_scale, m_displacement_floor);
     m_estimate = recovery_error_estimate(state);

@@ -140,6 +140,20 @@ double merged_local_error(const CutState& state, const RecoveryEstimate& estimat
 
 }  // namespace
 
+RecoveryGeometry recovery_geometry(const TetMesh& mesh) {
+  RecoveryGeometry geometry;
+  geometry.volume = tet_rest_volumes(mesh);
+  const Index num_tets = mesh.tets.rows();
+  geometry.size.resize(num_tets);
+  tbb::parallel_for(Index(0), num_tets, kTetChunk, [&](Index begin) {
+    const Index end = std::min(begin + kTetChunk, num_tets);
+    for (Index t = begin; t < end; ++t)
+      geometry.size[t] = std::cbrt(kRegularTetEdgeCubed * std::abs(geometry.volume[t]));
+  });
+  geometry.incident = vertex_tets(mesh.tets, mesh.vertices.rows());
+  return geometry;
+}
+
 RecoveryEstimate recovery_error_estimate(const CutState& state) {
   const TetMesh& mesh = state.flat.mesh;
   const Index num_tets = mesh.tets.rows();
@@ -147,28 +161,34 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
   const LameParameters lame = state.material.lame();
   STRATA_VERIFY(static_cast<Index>(state.flat.tet_levels.size()) == num_tets,
                 "recovery_error_estimate: the flat mesh has no levels for its tets");
-  const VectorXd volume = tet_rest_volumes(mesh);
+  RecoveryGeometry computed_geometry;
+  if (state.recovery_geometry == nullptr) computed_geometry = recovery_geometry(mesh);
+  const RecoveryGeometry& geometry =
+      state.recovery_geometry != nullptr ? *state.recovery_geometry : computed_geometry;
+  STRATA_VERIFY(geometry.volume.size() == num_tets && geometry.incident.size() == num_vertices,
+                "recovery_error_estimate: the rest geometry is not of this cut");
+  const VectorXd& volume = geometry.volume;
   const auto& strain = state.fields.green_strain;
 
-  // Per vertex, row by row: the volume-weighted sum of its tets' strains, then their volume; the
-  // sum becomes the recovered (mean) strain.
+  // Per vertex, row by row: the volume-weighted sum of its tets' strains (tets ascending), then
+  // their volume; the sum becomes the recovered (mean) strain.
   using RowStrains = Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>;
-  RowStrains recovered = RowStrains::Zero(num_vertices, 7);
-  for (Index t = 0; t < num_tets; ++t) {
-    double weighted[7];
-    for (int c = 0; c < 6; ++c)
-      weighted[c] = volume[t] * strain(t, c);
-    weighted[6] = volume[t];
-    for (int k = 0; k < 4; ++k) {
-      double* sums = recovered.row(mesh.tets(t, k)).data();
-      for (int c = 0; c < 7; ++c)
-        sums[c] += weighted[c];
-    }
-  }
+  RowStrains recovered(num_vertices, 7);
   tbb::parallel_for(Index(0), num_vertices, kTetChunk, [&](Index begin) {
     const Index end = std::min(begin + kTetChunk, num_vertices);
-    for (Index v = begin; v < end; ++v)
-      if (recovered(v, 6) > 0.0) recovered.row(v).head<6>() /= recovered(v, 6);
+    for (Index v = begin; v < end; ++v) {
+      double sums[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+      for (const int t : geometry.incident[v]) {
+        for (int c = 0; c < 6; ++c)
+          sums[c] += volume[t] * strain(t, c);
+        sums[6] += volume[t];
+      }
+      if (sums[6] > 0.0)
+        for (int c = 0; c < 6; ++c)
+          sums[c] /= sums[6];
+      for (int c = 0; c < 7; ++c)
+        recovered(v, c) = sums[c];
+    }
   });
 
   RecoveryEstimate estimate;
@@ -203,9 +223,7 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
       estimate.element_error_sq[t] = error_sq * removed[level] * removed[level];
       estimate.element_raw_error_sq[t] = error_sq;
       load_work_terms[t] = error_sq * c_share[level];
-      estimate.element_local_error[t] = local_share[level] *
-                                        std::cbrt(kRegularTetEdgeCubed * std::abs(volume[t])) *
-                                        largest_difference;
+      estimate.element_local_error[t] = local_share[level] * geometry.size[t] * largest_difference;
       energy_terms[t] = volume[t] * twice_energy_density(own, lame);
     }
   });

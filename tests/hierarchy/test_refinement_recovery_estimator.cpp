@@ -135,6 +135,27 @@ TEST(RecoveryEstimator, TheSameBitsAtAnyThreadCount) {
   EXPECT_EQ(one.relative_energy_error, two.relative_energy_error);
 }
 
+TEST(RecoveryEstimator, TheCutsRestGeometryKeptByTheDriverGivesTheSameBits) {
+  TetTree tree(slab(), 2);
+  const ActiveCut cut = mixed_cut(tree);
+  const test::CutSnapshot s = make_snapshot(cut, test_material(), kink, {});
+  const RecoveryEstimate computed = recovery_error_estimate(s.state());
+  const RecoveryGeometry geometry = recovery_geometry(s.cut.flat.mesh);
+  CutState state = s.state();
+  state.recovery_geometry = &geometry;
+  const RecoveryEstimate kept = recovery_error_estimate(state);
+  ASSERT_GT(computed.relative_error, 0.0);
+  EXPECT_EQ(kept.element_error_sq, computed.element_error_sq);
+  EXPECT_EQ(kept.element_local_error, computed.element_local_error);
+  EXPECT_EQ(kept.relative_error, computed.relative_error);
+  // The geometry of another cut is refused.
+  const ActiveCut coarse = ActiveCut::uniform(tree, 0);
+  const test::CutSnapshot other = make_snapshot(coarse, test_material(), kink, {});
+  const RecoveryGeometry wrong = recovery_geometry(other.cut.flat.mesh);
+  state.recovery_geometry = &wrong;
+  EXPECT_THROW(recovery_error_estimate(state), std::logic_error);
+}
+
 TEST(RecoveryIndicator, MarksTetsAboveTheirShareOfTheTolerance) {
   TetTree tree(slab(), 2);
   const ActiveCut cut = ActiveCut::uniform(tree, 0);

@@ -327,6 +327,9 @@ class AdaptiveSimulation final : public SimulationRun {
   /// integrator, with children_stable(); computed once per cut.
   bool cut_can_refine() const;
   mutable std::optional<bool> m_cut_can_refine;
+  /// The rest geometry the error estimate reads (recovery_geometry), computed once per cut.
+  const RecoveryGeometry* cut_geometry();
+  std::optional<RecoveryGeometry> m_cut_geometry;
   /// Whether solver.dt is within the stable-step estimate of `tets` (Bey-ordered positions) as a
   /// mesh of their own.
   bool stable_on_their_own(const std::vector<Matrix3x4d>& tets) const;

@@ -13,6 +13,7 @@
 namespace strata {
 
 struct RecoveryEstimate;
+struct RecoveryGeometry;
 
 /// A snapshot of the simulation on the flattened active cut `flat` of `tree` (#V vertices,
 /// #T tets). The referenced objects and the viewed vectors must outlive the snapshot.
@@ -53,6 +54,9 @@ struct CutState {
   /// Optional: the recovery estimate of this very state (refinement_recovery_estimator.hpp),
   /// when the driver has computed it already; the recovery indicator then reuses it.
   const RecoveryEstimate* recovery_estimate = nullptr;
+  /// Optional: the rest geometry of `flat` the recovery estimate reads (recovery_geometry), when
+  /// the driver keeps it for the cut; computed per estimate otherwise.
+  const RecoveryGeometry* recovery_geometry = nullptr;
   /// The decision's tolerance is the indicator's divided by this (≥ 1): a static run whose
   /// refinement passes measured changes larger than the estimate of the cuts they refined judges
   /// later decisions by that ratio (AdaptiveSimulation, README "Error control"), and a dynamic

@@ -71,6 +71,7 @@
 /// marked as well: η_t = max(η̂_t, δ_t / (τ max|u|)).
 #include <vector>
 
+#include "strata/core/common/compressed_lists.hpp"
 #include "strata/hierarchy/refinement_indicator.hpp"
 
 namespace strata {
@@ -109,7 +110,19 @@ struct RecoveryEstimate {
   double local_error = 0.0;
 };
 
-/// The estimate of `state` (a tree of depth state.tree.max_level()).
+/// What the estimate reads of a flat cut's rest geometry, the same for every state on the cut: the
+/// driver computes it once per cut and passes it in CutState::recovery_geometry.
+struct RecoveryGeometry {
+  VectorXd volume;           ///< #T signed rest volumes (tet_rest_volumes)
+  VectorXd size;             ///< #T: (6√2 |V|)^⅓, the edge of a regular tet of that volume [m]
+  CompressedLists incident;  ///< #V: the tets of each vertex, ascending
+};
+
+/// The rest geometry of `mesh` (parallel).
+RecoveryGeometry recovery_geometry(const TetMesh& mesh);
+
+/// The estimate of `state` (a tree of depth state.tree.max_level()). Uses
+/// state.recovery_geometry when given (it must be of state.flat.mesh), computes it otherwise.
 RecoveryEstimate recovery_error_estimate(const CutState& state);
 
 /// The merges of one change that fit a budget on the estimate.
