@@ -21,11 +21,10 @@ DofReduction::DofReduction(const SparseMatrixd& pattern, const std::vector<char>
   }
   // Removing rows and columns keeps each column's rows ascending: the reduced pattern is the
   // full one filtered, with the source of every value kept.
-  m_reduced_pattern.resize(num_free(), num_free());
+  m_outer.assign(num_free() + 1, 0);
   const int* full_outer = pattern.outerIndexPtr();
   const int* full_inner = pattern.innerIndexPtr();
-  int* outer = m_reduced_pattern.outerIndexPtr();
-  outer[0] = 0;
+  int* outer = m_outer.data();
   tbb::parallel_for(Index(0), num_free(), [&](Index c) {
     int count = 0;
     for (Index p = full_outer[m_free[c]]; p < full_outer[m_free[c] + 1]; ++p)
@@ -35,17 +34,15 @@ DofReduction::DofReduction(const SparseMatrixd& pattern, const std::vector<char>
   for (Index c = 0; c < num_free(); ++c)
     outer[c + 1] += outer[c];
   const Index nnz = outer[num_free()];
-  m_reduced_pattern.resizeNonZeros(nnz);
+  m_inner.resize(nnz);
   m_source.resize(nnz);
-  int* inner = m_reduced_pattern.innerIndexPtr();
-  double* values = m_reduced_pattern.valuePtr();
+  int* inner = m_inner.data();
   tbb::parallel_for(Index(0), num_free(), [&](Index c) {
     Index k = outer[c];
     for (int p = full_outer[m_free[c]]; p < full_outer[m_free[c] + 1]; ++p) {
       const int row = reduced_index[full_inner[p]];
       if (row < 0) continue;
       inner[k] = row;
-      values[k] = 0.0;
       m_source[k++] = p;
     }
   });
@@ -67,8 +64,20 @@ void DofReduction::add_prolonged(ConstRef<VectorXd> reduced, VectorXd& full) con
 void DofReduction::restrict_matrix(const SparseMatrixd& full, SparseMatrixd& reduced) const {
   STRATA_VERIFY(full.nonZeros() == m_full_nonzeros && full.isCompressed(),
                 "DofReduction: matrix does not have the construction pattern");
-  if (reduced.rows() != num_free() || reduced.nonZeros() != m_reduced_pattern.nonZeros())
-    reduced = m_reduced_pattern;
+  const auto nnz = static_cast<Index>(m_inner.size());
+  if (reduced.rows() != num_free() || reduced.cols() != num_free() || !reduced.isCompressed() ||
+      reduced.nonZeros() != nnz ||
+      !std::equal(m_outer.begin(), m_outer.end(), reduced.outerIndexPtr())) {
+    // The reduced pattern; its values are all written below.
+    reduced.resize(num_free(), num_free());
+    reduced.resizeNonZeros(nnz);
+    std::copy(m_outer.begin(), m_outer.end(), reduced.outerIndexPtr());
+    int* inner = reduced.innerIndexPtr();
+    tbb::parallel_for(
+        tbb::blocked_range<Index>(0, nnz, 65536), [&](const tbb::blocked_range<Index>& r) {
+          std::copy(m_inner.begin() + r.begin(), m_inner.begin() + r.end(), inner + r.begin());
+        });
+  }
   double* values = reduced.valuePtr();
   const double* source = full.valuePtr();
   const int* from = m_source.data();

@@ -5,6 +5,7 @@
 /// so reducing a matrix is a gather of its values.
 #include <vector>
 
+#include "strata/core/common/fill_vector.hpp"
 #include "strata/core/common/types.hpp"
 
 namespace strata {
@@ -29,8 +30,10 @@ class DofReduction {
 
  private:
   std::vector<Index> m_free;
-  SparseMatrixd m_reduced_pattern;
-  std::vector<int> m_source;  ///< for each reduced value, its index in the full value array
+  /// The reduced pattern's column starts and rows (its values are those of each matrix reduced).
+  std::vector<int> m_outer;
+  FillVector<int> m_inner;
+  FillVector<int> m_source;  ///< for each reduced value, its index in the full value array
   Index m_full_nonzeros = 0;
 };
 
