@@ -231,6 +231,8 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
                 "recovery_error_estimate: the rest geometry is not of this cut");
   const VectorXd& volume = geometry.volume;
   const auto& strain = state.fields.green_strain;
+  STRATA_VERIFY(strain.rows() == num_tets,
+                "recovery_error_estimate: the strains are not of this cut's tets");
 
   // Per vertex, row by row: the volume-weighted sum of its tets' strains (tets ascending), then
   // their volume; the sum becomes the recovered (mean) strain.

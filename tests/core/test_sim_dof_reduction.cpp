@@ -67,13 +67,11 @@ TEST(DofReduction, TheFreeBlockOfEachMatrixInThePattern) {
   EXPECT_TRUE(reduced.isCompressed());
   EXPECT_EQ(Eigen::MatrixXd(reduced), dense_free_block(A, constrained));
 
-  // The next matrix of the pattern: only the values are gathered again.
+  // The next matrix of the pattern, into the same target.
   SparseMatrixd B = A;
   for (Index k = 0; k < B.nonZeros(); ++k)
     B.valuePtr()[k] = 2.0 * B.valuePtr()[k] + 1.0;
-  const int* pattern_rows = reduced.innerIndexPtr();
   reduction.restrict_matrix(B, reduced);
-  EXPECT_EQ(reduced.innerIndexPtr(), pattern_rows);
   EXPECT_EQ(Eigen::MatrixXd(reduced), dense_free_block(B, constrained));
 
   // A target holding another pattern with as many non-zeros (its first columns full) gets the

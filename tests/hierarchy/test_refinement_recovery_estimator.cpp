@@ -11,6 +11,7 @@
 #include "refinement_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/common/parallel.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/hierarchy/refinement_recovery_estimator.hpp"
 
 namespace strata {
@@ -154,6 +155,70 @@ TEST(RecoveryEstimator, TheCutsRestGeometryKeptByTheDriverGivesTheSameBits) {
   const RecoveryGeometry wrong = recovery_geometry(other.cut.flat.mesh);
   state.recovery_geometry = &wrong;
   EXPECT_THROW(recovery_error_estimate(state), std::logic_error);
+}
+
+TEST(RecoveryEstimator, EveryTetsTermsAsTheirDefinitionGivesThem) {
+  // 3,463 tets: more than one parallel task of the terms, and not a multiple of the four tets the
+  // terms are computed at a time. Reference: the definitions in the header, tet by tet.
+  TetTree tree(slab(), 2);
+  ActiveCut cut = ActiveCut::uniform(tree, 1);
+  cut.refine(tree.child(7, 3));
+  // Quadratic: no tet's strain is its vertices' recovered one, the last tets' included.
+  const auto quadratic = [](const Vector3d& X) {
+    return Vector3d(0.01 * X.x() * X.x(), 0.01 * X.x() * X.y(), 0.02 * X.z() * X.z());
+  };
+  const test::CutSnapshot s = make_snapshot(cut, test_material(), quadratic, {});
+  const TetMesh& mesh = s.cut.flat.mesh;
+  const Index num_tets = mesh.tets.rows();
+  ASSERT_EQ(num_tets % 4, 3);
+  const RecoveryEstimate estimate = recovery_error_estimate(s.state());
+  const auto& strain = s.fields.green_strain;
+  const LameParameters lame = test_material().lame();
+  const auto twice_psi = [&](const Vector6d& e) {
+    const double trace = e[0] + e[1] + e[2];
+    return 2.0 * lame.mu * (e.head<3>().squaredNorm() + 2.0 * e.tail<3>().squaredNorm()) +
+           lame.lambda * trace * trace;
+  };
+  std::vector<double> volume(num_tets);
+  Eigen::MatrixXd sums = Eigen::MatrixXd::Zero(mesh.vertices.rows(), 7);
+  for (Index t = 0; t < num_tets; ++t) {
+    volume[t] = tet_signed_volume(mesh.vertices.row(mesh.tets(t, 0)).transpose(),
+                                  mesh.vertices.row(mesh.tets(t, 1)).transpose(),
+                                  mesh.vertices.row(mesh.tets(t, 2)).transpose(),
+                                  mesh.vertices.row(mesh.tets(t, 3)).transpose());
+    for (int k = 0; k < 4; ++k) {
+      sums.row(mesh.tets(t, k)).head<6>() += volume[t] * strain.row(t);
+      sums(mesh.tets(t, k), 6) += volume[t];
+    }
+  }
+  const int depth = tree.max_level();
+  VectorXd raw(num_tets), local(num_tets);
+  for (Index t = 0; t < num_tets; ++t) {
+    const Vector6d own = strain.row(t).transpose();
+    Vector6d sum = Vector6d::Zero();
+    double vertex_terms = 0.0, largest = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const Index v = mesh.tets(t, k);
+      const Vector6d d = sums.row(v).head<6>().transpose() / sums(v, 6) - own;
+      vertex_terms += twice_psi(d);
+      sum += d;
+      largest =
+          std::max(largest, std::sqrt(d.head<3>().squaredNorm() + 2.0 * d.tail<3>().squaredNorm()));
+    }
+    raw[t] = volume[t] / 20.0 * (vertex_terms + twice_psi(sum));
+    const int level = s.cut.flat.tet_levels[t];
+    local[t] = (1.0 - std::ldexp(1.0, -(depth - level))) *
+               std::cbrt(6.0 * std::sqrt(2.0) * std::abs(volume[t])) * largest;
+  }
+  // Relative to the largest term, and each of the last tets' to itself.
+  ASSERT_GT(raw.maxCoeff(), 0.0);
+  ASSERT_GT(local.maxCoeff(), 0.0);
+  EXPECT_LE((estimate.element_raw_error_sq - raw).cwiseAbs().maxCoeff(), 1e-12 * raw.maxCoeff());
+  EXPECT_LE((estimate.element_local_error - local).cwiseAbs().maxCoeff(), 1e-12 * local.maxCoeff());
+  for (Index t = num_tets - 4; t < num_tets; ++t) {
+    EXPECT_GT(raw[t], 1e-6 * raw.maxCoeff()) << "tet " << t;
+    EXPECT_NEAR(estimate.element_raw_error_sq[t], raw[t], 1e-10 * raw[t]) << "tet " << t;
+  }
 }
 
 TEST(RecoveryIndicator, MarksTetsAboveTheirShareOfTheTolerance) {

@@ -25,7 +25,9 @@ class DofReduction {
   /// full[free] += reduced.
   void add_prolonged(ConstRef<VectorXd> reduced, VectorXd& full) const;
   /// The free–free block of `full`, which must have exactly the pattern given at construction.
-  /// `reduced` gets the reduced pattern on first use; afterwards only its values are rewritten.
+  /// `reduced` gets the reduced pattern unless it has the reduced size, non-zeros and column
+  /// starts already (its rows are then taken to be the reduced pattern's: pass a matrix this
+  /// reduction filled, or any other); only the values are written then.
   void restrict_matrix(const SparseMatrixd& full, SparseMatrixd& reduced) const;
 
  private:
