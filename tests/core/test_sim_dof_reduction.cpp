@@ -6,35 +6,13 @@
 #include <random>
 #include <vector>
 
+#include "sparse_test_utils.hpp"
 #include "strata/core/sim/dof_reduction.hpp"
 
 namespace strata {
 namespace {
 
-/// A random symmetric 3n × 3n matrix made of whole 3 × 3 blocks (a vertex graph with about
-/// `neighbours` random neighbours per vertex), compressed.
-SparseMatrixd random_block_matrix(Index n, int neighbours, std::mt19937& random) {
-  std::uniform_int_distribution<Index> vertex(0, n - 1);
-  std::uniform_real_distribution<double> value(-1.0, 1.0);
-  std::vector<Eigen::Triplet<double>> triplets;
-  const auto add_block = [&](Index a, Index b) {
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const double v = value(random);
-        triplets.emplace_back(3 * a + i, 3 * b + j, v);
-        triplets.emplace_back(3 * b + j, 3 * a + i, v);
-      }
-  };
-  for (Index a = 0; a < n; ++a) {
-    add_block(a, a);
-    for (int k = 0; k < neighbours; ++k)
-      add_block(a, vertex(random));
-  }
-  SparseMatrixd A(3 * n, 3 * n);
-  A.setFromTriplets(triplets.begin(), triplets.end());
-  A.makeCompressed();
-  return A;
-}
+using testing::random_block_matrix;
 
 /// The free–free block of A, entry by entry.
 Eigen::MatrixXd dense_free_block(const SparseMatrixd& A, const std::vector<char>& constrained) {
