@@ -75,6 +75,7 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.linear_iterations += b.linear_iterations;
   a.reused_factor_solves += b.reused_factor_solves;
   a.multigrid_setups += b.multigrid_setups;
+  a.multigrid_carried_setups += b.multigrid_carried_setups;
   a.multigrid_setup_seconds += b.multigrid_setup_seconds;
   a.multigrid_direct_fallbacks += b.multigrid_direct_fallbacks;
   a.linear_solver = b.linear_solver;
@@ -519,11 +520,13 @@ SimulationOptions AdaptiveSimulation::flatten(long first_step) {
 }
 
 double AdaptiveSimulation::rebuild(long first_step,
-                                   std::vector<SmootherEstimate> smoother_estimates) {
+                                   std::vector<SmootherEstimate> smoother_estimates,
+                                   std::shared_ptr<MultigridCoarseLevels> coarse_levels) {
   const auto start = Clock::now();
   m_simulation_change = -1;
   SimulationOptions options = flatten(first_step);
   options.smoother_estimates = std::move(smoother_estimates);
+  options.coarse_levels = std::move(coarse_levels);
   const double flatten_seconds = seconds_since(start);
   m_mesh_external = peak_loads(options);
   m_simulation = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
@@ -825,14 +828,17 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   record.coarsened = counts.coarsened;
 
   // The smoothers' eigenvalue estimates carry over: the levels of the new cut are mostly those of
-  // the old one, changed where the cut changed.
+  // the old one, changed where the cut changed. So do the coarse levels, where the new cut's are
+  // the same (MultigridPreconditioner::offer_coarse_levels).
   std::vector<SmootherEstimate> smoother_estimates = m_simulation->smoother_estimates();
+  std::shared_ptr<MultigridCoarseLevels> coarse_levels = m_simulation->release_coarse_levels();
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);
   m_finished_counters = add(m_finished_counters, old_counters);
   m_simulation.reset();
   try {
     record.phases.edit = lap();
-    record.phases.flatten = rebuild(first_step, std::move(smoother_estimates));
+    record.phases.flatten =
+        rebuild(first_step, std::move(smoother_estimates), std::move(coarse_levels));
     const SimulationBuildSeconds& built = m_simulation->build_seconds();
     record.phases.elastic_model = built.elastic_model;
     record.phases.reduced_model = built.reduced_model;
@@ -903,6 +909,7 @@ void AdaptiveSimulation::note_solver_setups() {
   const SimulationCounters counters = m_simulation->counters();
   CutChangeRecord& record = m_changes[static_cast<std::size_t>(m_simulation_change)];
   record.multigrid_setups = counters.multigrid_setups;
+  record.multigrid_carried_setups = counters.multigrid_carried_setups;
   record.multigrid_setup_seconds = counters.multigrid_setup_seconds;
 }
 

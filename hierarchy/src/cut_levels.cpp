@@ -1,6 +1,7 @@
 #include "strata/hierarchy/cut_levels.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -23,6 +24,7 @@ NestedSpaces merge_weak_levels(const NestedSpaces& spaces) {
     if (size <= 0.7 * kept_size) {
       merged.prolongations.push_back(P);
       merged.injections.push_back(injection);
+      if (!spaces.keys.empty()) merged.keys.push_back(spaces.keys[k]);
       kept_size = size;
       if (k > 0) {
         P = spaces.prolongations[k - 1];
@@ -38,6 +40,7 @@ NestedSpaces merge_weak_levels(const NestedSpaces& spaces) {
   }
   std::reverse(merged.prolongations.begin(), merged.prolongations.end());
   std::reverse(merged.injections.begin(), merged.injections.end());
+  std::reverse(merged.keys.begin(), merged.keys.end());
   return merged;
 }
 
@@ -95,6 +98,10 @@ NestedSpaces cut_nested_spaces(const TetTree& tree, const ConstrainedCut& cut) {
     P.setFromTriplets(triplets.begin(), triplets.end());
     spaces.prolongations.push_back(std::move(P));
     spaces.injections.push_back(std::move(injection));
+    // The tree vertices of space k: what the next cut's space k is compared with.
+    std::vector<std::int64_t>& keys = spaces.keys.emplace_back(sizes[k]);
+    for (Index q = 0; q < num_free; ++q)
+      if (index[k][q] >= 0) keys[index[k][q]] = flat.tree_vertices[free_vertices[q]];
   }
   return merge_weak_levels(spaces);
 }

@@ -311,8 +311,12 @@ TEST(AdaptiveSimulation, RefinementKeepsTheEnergyAndTheCutFollowsTheLoad) {
 TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
   // The solve after a change builds the multigrid hierarchy of the new cut: each change's record
   // holds the setups made on its cut, all of the run's but those on the initial cut. CHOLMOD
-  // builds none.
+  // builds none. Where the new cut's coarse spaces are those of the cut before (here the level-1
+  // vertices: every cut holds the whole slab at level 1 or finer), the setup keeps the coarse
+  // levels and sets up only the finest; the run still reaches the states CHOLMOD's run reaches.
   const PressedSlab slab;
+  std::vector<VectorXd> final_positions;
+  std::vector<std::vector<Index>> cut_sizes;
   for (const LinearSolverKind solver : {LinearSolverKind::multigrid, LinearSolverKind::cholmod}) {
     // From level 1: the cuts have a coarse level of an eighth of their vertices (a space that
     // shrinks less is merged into the next, and a single level is solved by CHOLMOD).
@@ -321,9 +325,13 @@ TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
                            std::nullopt, Vector3d::Zero(), setup.solver);
     run(sim);
     ASSERT_GE(sim.changes().size(), 2u);
-    long recorded = 0;
+    long recorded = 0, carried = 0;
+    std::vector<Index>& sizes = cut_sizes.emplace_back();
     for (const CutChangeRecord& change : sim.changes()) {
+      sizes.push_back(change.tets_after);
       recorded += change.multigrid_setups;
+      carried += change.multigrid_carried_setups;
+      EXPECT_LE(change.multigrid_carried_setups, change.multigrid_setups);
       if (solver == LinearSolverKind::cholmod) {
         EXPECT_EQ(change.multigrid_setups, 0);
         EXPECT_EQ(change.multigrid_setup_seconds, 0.0);
@@ -338,10 +346,21 @@ TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
       // The initial cut's (at least its first solve) are the ones no change holds.
       EXPECT_GE(counters.multigrid_setups - recorded, 1);
       EXPECT_LE(recorded, counters.multigrid_setups);
+      EXPECT_GE(carried, 1);
+      EXPECT_EQ(counters.multigrid_carried_setups, carried);
+      RecordProperty("carried setups", std::to_string(carried) + " of " +
+                                           std::to_string(recorded) + " after cut changes");
     } else {
       EXPECT_EQ(counters.multigrid_setups, 0);
+      EXPECT_EQ(carried, 0);
     }
+    final_positions.push_back(sim.simulation().positions() -
+                              flatten(sim.simulation().mesh().vertices));
   }
+  ASSERT_EQ(cut_sizes[0], cut_sizes[1]);  // the same cuts, so the same final mesh
+  const double scale = final_positions[1].lpNorm<Eigen::Infinity>();
+  ASSERT_GT(scale, 0.0);
+  EXPECT_LE((final_positions[0] - final_positions[1]).lpNorm<Eigen::Infinity>(), 1e-7 * scale);
 }
 
 TEST(AdaptiveSimulation, ACutChangeSeedsTheNewCutsSmoothersWithThoseOfTheCutBefore) {

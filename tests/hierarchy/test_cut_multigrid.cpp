@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -399,6 +401,152 @@ TEST(CutMultigrid, ASeededHierarchyThatDoesNotConvergeIsSetUpAgainMeasured) {
   const std::vector<SmootherEstimate> own = measured.smoother_estimates();
   for (std::size_t k = 0; k < own.size(); ++k)
     EXPECT_EQ(now[k].lambda, own[k].lambda);
+}
+
+/// Level 2 everywhere, level 3 where x < `x_fine`: cuts whose coarse spaces (the vertices of
+/// levels ≤ 2, none of them hanging) are the same for every `x_fine`.
+ActiveCut band_cut(TetTree& tree, double x_fine) {
+  ActiveCut cut = ActiveCut::uniform(tree, 2);
+  for (const NodeId n : cut.sorted_nodes())
+    if (tree.tet_positions(n).row(0).minCoeff() < x_fine) cut.refine(n);
+  return cut;
+}
+
+// A cut change whose new cut has the same coarse spaces carries the coarse levels over
+// (MultigridPreconditioner::release_coarse_levels, offer_coarse_levels): the new hierarchy sets up
+// only its finest level, and multigrid-PCG on it reaches the direct solution of the new cut.
+TEST(CutMultigrid, CoarseLevelsCarryOverToACutWithTheSameCoarseSpaces) {
+  for (const double nu : {0.3, 0.49}) {
+    SCOPED_TRACE("nu " + std::to_string(nu));
+    TetTree tree(beam(), 3);
+    const ClampedSystem old_system = clamped_system(band_cut(tree, 0.4), nu);
+    const ClampedSystem system = clamped_system(band_cut(tree, 0.9), nu);
+    ASSERT_GT(system.A.rows(), old_system.A.rows());
+    ASSERT_EQ(system.spaces.num_levels(), 4);
+    EXPECT_EQ(system.spaces.keys, old_system.spaces.keys);
+    EXPECT_EQ(free_dof_keys(system.spaces, system.free_dofs),
+              free_dof_keys(old_system.spaces, old_system.free_dofs));
+
+    SpdSolver old_solver(LinearSolverKind::multigrid);
+    old_solver.use_nested_spaces(&old_system.spaces, old_system.free_dofs);
+    EXPECT_EQ(old_solver.release_coarse_levels(), nullptr);  // before any setup
+    VectorXd x;
+    ASSERT_TRUE(old_solver.solve(old_system.A, old_system.b, x));
+    const std::vector<SmootherEstimate> seeds = old_solver.smoother_estimates();
+    std::shared_ptr<MultigridCoarseLevels> levels = old_solver.release_coarse_levels();
+    ASSERT_NE(levels, nullptr);
+    // The solver that gave them up sets up anew and still solves its system.
+    VectorXd x_old;
+    SpdSolver old_direct(LinearSolverKind::cholmod);
+    ASSERT_TRUE(old_direct.solve(old_system.A, old_system.b, x_old));
+    ASSERT_TRUE(old_solver.solve(old_system.A, old_system.b, x));
+    EXPECT_EQ(old_solver.multigrid_setups(), 2);
+    EXPECT_EQ(old_solver.carried_setups(), 0);
+    EXPECT_LE((x - x_old).norm(), 1e-8 * x_old.norm());
+
+    SpdSolver direct(LinearSolverKind::cholmod);
+    VectorXd x_direct;
+    ASSERT_TRUE(direct.solve(system.A, system.b, x_direct));
+    long iterations[2] = {0, 0};
+    for (const bool carry : {false, true}) {
+      SpdSolver solver(LinearSolverKind::multigrid);
+      solver.use_nested_spaces(&system.spaces, system.free_dofs, seeds,
+                               carry ? levels : std::shared_ptr<MultigridCoarseLevels>{});
+      ASSERT_TRUE(solver.solve(system.A, system.b, x));
+      EXPECT_EQ(solver.multigrid_setups(), 1);
+      EXPECT_EQ(solver.carried_setups(), carry ? 1 : 0);
+      EXPECT_EQ(solver.direct_fallbacks(), 0);
+      EXPECT_LE((x - x_direct).norm(), 1e-8 * x_direct.norm()) << (carry ? "carried" : "own");
+      iterations[carry ? 1 : 0] = solver.cg_iterations();
+    }
+    // The coarse operators of a nearby cut precondition about as well as the cut's own.
+    EXPECT_LE(iterations[1], iterations[0] + 3);
+    RecordProperty("nu " + std::to_string(nu), std::to_string(iterations[0]) + " own, " +
+                                                   std::to_string(iterations[1]) + " carried");
+    // Taken once: offered again, they are not there to take.
+    SpdSolver again(LinearSolverKind::multigrid);
+    again.use_nested_spaces(&system.spaces, system.free_dofs, seeds, levels);
+    ASSERT_TRUE(again.solve(system.A, system.b, x));
+    EXPECT_EQ(again.carried_setups(), 0);
+    EXPECT_LE((x - x_direct).norm(), 1e-8 * x_direct.norm());
+  }
+}
+
+// The V-cycle of a hierarchy on carried coarse levels is the cycle of the system they came from
+// with the new finest operator, bit for bit: on one cut, levels set up on A and carried to 2A
+// give the cycle of a hierarchy set up on A and then updated to 2A (update_finest), and not that
+// of a hierarchy set up on 2A (whose coarse operators are twice as large). Levels whose keys or
+// prolongations differ from the hierarchy's own are not taken.
+TEST(CutMultigrid, ACarriedCycleIsThePreviousSystemsCoarseLevelsUnderTheNewFinest) {
+  TetTree tree(beam(), 3);
+  const ClampedSystem system = clamped_system(band_cut(tree, 0.6), 0.3);
+  const SparseMatrixd& A = system.A;
+  const SparseMatrixd A2 = 2.0 * A;
+  const std::vector<SparseMatrixd> prolongations =
+      free_dof_prolongations(system.spaces, system.free_dofs);
+  const std::vector<std::vector<std::int64_t>> keys =
+      free_dof_keys(system.spaces, system.free_dofs);
+  ASSERT_EQ(keys.size(), prolongations.size());
+  ASSERT_GE(prolongations.size(), 2u);
+  const MultigridOptions options;
+  const auto give_up_levels = [&](double rate) {
+    MultigridPreconditioner giver(prolongations, options, keys);
+    EXPECT_TRUE(giver.setup(A));
+    return giver.release_coarse_levels(rate);
+  };
+  const auto cycle = [&](const MultigridPreconditioner& m) {
+    VectorXd r(A.rows()), z;
+    for (Index i = 0; i < r.size(); ++i)
+      r[i] = std::sin(0.37 * static_cast<double>(i));
+    m.apply(r, z);
+    return z;
+  };
+  MultigridPreconditioner reference(prolongations, options, keys);
+  ASSERT_TRUE(reference.setup(A));
+  const std::vector<SmootherEstimate> estimates = reference.smoother_estimates();
+  reference.update_finest(A2);
+  MultigridPreconditioner own(prolongations, options, keys);
+  ASSERT_TRUE(own.setup(A2));
+
+  MultigridPreconditioner carried(prolongations, options, keys);
+  carried.offer_coarse_levels(give_up_levels(7.5));
+  carried.seed_smoother_estimates(estimates);  // D⁻¹A and its spectrum do not scale with A
+  ASSERT_TRUE(carried.setup(A2));
+  EXPECT_TRUE(carried.carried_setup());
+  EXPECT_EQ(carried.carried_iterations_per_decade(), 7.5);
+  EXPECT_EQ(carried.level_sizes(), reference.level_sizes());
+  const VectorXd z = cycle(carried);
+  EXPECT_EQ((z - cycle(reference)).lpNorm<Eigen::Infinity>(), 0.0);
+  EXPECT_GT((z - cycle(own)).norm(), 1e-3 * z.norm());
+  // The next setup computes its own levels.
+  ASSERT_TRUE(carried.setup(A2));
+  EXPECT_FALSE(carried.carried_setup());
+  EXPECT_EQ(carried.carried_iterations_per_decade(), -1.0);
+  EXPECT_EQ((cycle(carried) - cycle(own)).lpNorm<Eigen::Infinity>(), 0.0);
+
+  // Other keys, or another prolongation between the coarse levels: not taken.
+  std::vector<std::vector<std::int64_t>> other_keys = keys;
+  other_keys[1][0] += 3;
+  std::vector<SparseMatrixd> other_prolongations = prolongations;
+  other_prolongations[0].valuePtr()[0] *= 1.0 + 1e-12;
+  for (const bool by_keys : {true, false}) {
+    SCOPED_TRACE(by_keys ? "keys" : "prolongation");
+    MultigridPreconditioner m(by_keys ? prolongations : other_prolongations, options,
+                              by_keys ? other_keys : keys);
+    m.offer_coarse_levels(give_up_levels(-1.0));
+    ASSERT_TRUE(m.setup(A2));
+    EXPECT_FALSE(m.carried_setup());
+    if (by_keys) {
+      EXPECT_EQ((cycle(m) - cycle(own)).lpNorm<Eigen::Infinity>(), 0.0);
+    }
+  }
+  // Without keys nothing is given up or taken.
+  MultigridPreconditioner keyless(prolongations, options);
+  ASSERT_TRUE(keyless.setup(A));
+  EXPECT_EQ(keyless.release_coarse_levels(), nullptr);
+  keyless.offer_coarse_levels(give_up_levels(-1.0));
+  ASSERT_TRUE(keyless.setup(A2));
+  EXPECT_FALSE(keyless.carried_setup());
 }
 
 // Deterministic PCG iteration counts (relative residual 10⁻¹⁰) of uniform cuts at levels 1–3:

@@ -32,15 +32,26 @@ struct SpdSolver::Cycle {
   /// the cycle's levels are the tree's (the algebraic cycle's are rebuilt with their system).
   virtual std::vector<SmootherEstimate> smoother_estimates() const { return {}; }
   virtual void seed_smoother_estimates(std::vector<SmootherEstimate> /*estimates*/) {}
+  /// Whether the last setup took anything of a previous hierarchy (seeded estimates or its coarse
+  /// levels).
   virtual bool seeded_setup() const { return false; }
+  /// MultigridPreconditioner::release_coarse_levels, offer_coarse_levels, carried_setup and
+  /// carried_iterations_per_decade (the tree's levels only).
+  virtual std::shared_ptr<MultigridCoarseLevels> release_coarse_levels(double /*rate*/) {
+    return nullptr;
+  }
+  virtual void offer_coarse_levels(std::shared_ptr<MultigridCoarseLevels> /*levels*/) {}
+  virtual bool carried_setup() const { return false; }
+  virtual double carried_iterations_per_decade() const { return -1.0; }
 };
 
 namespace {
 
 struct TreeCycle final : SpdSolver::Cycle {
   MultigridPreconditioner preconditioner;
-  TreeCycle(std::vector<SparseMatrixd> prolongations, const MultigridOptions& options)
-      : preconditioner(std::move(prolongations), options) {}
+  TreeCycle(std::vector<SparseMatrixd> prolongations, const MultigridOptions& options,
+            std::vector<std::vector<std::int64_t>> coarse_keys)
+      : preconditioner(std::move(prolongations), options, std::move(coarse_keys)) {}
   bool setup(const SparseMatrixd& A) override { return preconditioner.setup(A); }
   void update_finest(const SparseMatrixd& A) override { preconditioner.update_finest(A); }
   void apply(ConstRef<VectorXd> r, VectorXd& z) const override { preconditioner.apply(r, z); }
@@ -57,7 +68,19 @@ struct TreeCycle final : SpdSolver::Cycle {
   void seed_smoother_estimates(std::vector<SmootherEstimate> estimates) override {
     preconditioner.seed_smoother_estimates(std::move(estimates));
   }
-  bool seeded_setup() const override { return preconditioner.seeded_setup(); }
+  bool seeded_setup() const override {
+    return preconditioner.seeded_setup() || preconditioner.carried_setup();
+  }
+  std::shared_ptr<MultigridCoarseLevels> release_coarse_levels(double rate) override {
+    return preconditioner.release_coarse_levels(rate);
+  }
+  void offer_coarse_levels(std::shared_ptr<MultigridCoarseLevels> levels) override {
+    preconditioner.offer_coarse_levels(std::move(levels));
+  }
+  bool carried_setup() const override { return preconditioner.carried_setup(); }
+  double carried_iterations_per_decade() const override {
+    return preconditioner.carried_iterations_per_decade();
+  }
 };
 
 /// BoomerAMG's coarse spaces with strata's cycle: the interpolations come from hypre (once per
@@ -135,7 +158,8 @@ SpdSolver::SpdSolver(LinearSolverKind kind)
 SpdSolver::~SpdSolver() = default;
 
 void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs,
-                                  std::vector<SmootherEstimate> smoother_estimates) {
+                                  std::vector<SmootherEstimate> smoother_estimates,
+                                  std::shared_ptr<MultigridCoarseLevels> coarse_levels) {
   const LinearSolverKind requested = m_requested;
   m_rows = m_nonzeros = m_multigrid_rows = m_multigrid_nonzeros = -1;
   m_has_factor = false;
@@ -150,10 +174,11 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
   m_free_dofs = free_dofs;
   if (multigrid) {
     m_kind = LinearSolverKind::multigrid;
-    m_multigrid =
-        std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs), m_cycle_options);
+    m_multigrid = std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs),
+                                              m_cycle_options, free_dof_keys(*spaces, free_dofs));
     if (!smoother_estimates.empty())
       m_multigrid->seed_smoother_estimates(std::move(smoother_estimates));
+    if (coarse_levels != nullptr) m_multigrid->offer_coarse_levels(std::move(coarse_levels));
   } else if (requested == LinearSolverKind::amg) {
     use_algebraic_multigrid();
   } else if (requested == LinearSolverKind::automatic) {
@@ -177,6 +202,14 @@ int SpdSolver::multigrid_levels() const {
 std::vector<SmootherEstimate> SpdSolver::smoother_estimates() const {
   if (m_multigrid == nullptr || m_multigrid_setups == 0) return {};
   return m_multigrid->smoother_estimates();
+}
+
+std::shared_ptr<MultigridCoarseLevels> SpdSolver::release_coarse_levels() {
+  if (m_multigrid == nullptr || m_multigrid_setups == 0 || m_multigrid_stale) return nullptr;
+  std::shared_ptr<MultigridCoarseLevels> levels =
+      m_multigrid->release_coarse_levels(m_iterations_per_decade);
+  if (levels != nullptr) m_multigrid_stale = true;
+  return levels;
 }
 
 bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
@@ -277,7 +310,10 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
     const bool ok = m_multigrid->setup(A);
     m_multigrid_setup_seconds += m_multigrid->setup_seconds();
     m_multigrid_stale = !ok;
-    m_iterations_per_decade = -1.0;
+    // Carried coarse levels keep the reference rate of the hierarchy that computed them.
+    if (m_multigrid->carried_setup()) ++m_carried_setups;
+    m_iterations_per_decade =
+        m_multigrid->carried_setup() ? m_multigrid->carried_iterations_per_decade() : -1.0;
     return ok;
   };
   // Multigrid could not solve this system: CHOLMOD decides. If A factorises, multigrid is not up

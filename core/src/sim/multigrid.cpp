@@ -24,6 +24,14 @@ namespace strata {
 void NestedSpaces::check() const {
   if (injections.size() != prolongations.size())
     throw std::invalid_argument("NestedSpaces: one injection per prolongation expected");
+  if (!keys.empty()) {
+    if (keys.size() != prolongations.size())
+      throw std::invalid_argument("NestedSpaces: one key list per coarse space expected");
+    for (std::size_t k = 0; k < keys.size(); ++k)
+      if (static_cast<Index>(keys[k].size()) != prolongations[k].cols())
+        throw std::invalid_argument("NestedSpaces: key list " + std::to_string(k) +
+                                    " has the wrong size");
+  }
   for (std::size_t k = 0; k < prolongations.size(); ++k) {
     const SparseMatrixd& P = prolongations[k];
     if (k + 1 < prolongations.size() && prolongations[k + 1].cols() != P.rows())
@@ -45,12 +53,12 @@ void NestedSpaces::check() const {
   }
 }
 
-std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
-                                                  const std::vector<Index>& free_dofs) {
-  std::vector<SparseMatrixd> result;
-  if (spaces.empty()) return result;
+namespace {
+
+/// The free index of each DOF of each space (−1: constrained), finest last.
+std::vector<std::vector<Index>> free_indices(const NestedSpaces& spaces,
+                                             const std::vector<Index>& free_dofs) {
   const int levels = spaces.num_levels();
-  // free index of each DOF per level (−1: constrained), finest last.
   std::vector<std::vector<Index>> free_index(levels);
   const Index num_dofs = 3 * spaces.num_fine_vertices();
   free_index[levels - 1].assign(num_dofs, -1);
@@ -69,6 +77,31 @@ std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
       for (int c = 0; c < 3; ++c)
         if (free_index[k + 1][3 * injection[j] + c] >= 0) index[3 * j + c] = next++;
   }
+  return free_index;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::int64_t>> free_dof_keys(const NestedSpaces& spaces,
+                                                     const std::vector<Index>& free_dofs) {
+  std::vector<std::vector<std::int64_t>> result;
+  if (spaces.empty() || spaces.keys.empty()) return result;
+  const std::vector<std::vector<Index>> free_index = free_indices(spaces, free_dofs);
+  for (int k = 0; k + 1 < spaces.num_levels(); ++k) {
+    std::vector<std::int64_t>& keys = result.emplace_back();
+    for (std::size_t j = 0; j < spaces.keys[k].size(); ++j)
+      for (int c = 0; c < 3; ++c)
+        if (free_index[k][3 * j + c] >= 0) keys.push_back(3 * spaces.keys[k][j] + c);
+  }
+  return result;
+}
+
+std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
+                                                  const std::vector<Index>& free_dofs) {
+  std::vector<SparseMatrixd> result;
+  if (spaces.empty()) return result;
+  const int levels = spaces.num_levels();
+  const std::vector<std::vector<Index>> free_index = free_indices(spaces, free_dofs);
   // Column 3j + c of P_k ⊗ I₃ holds the rows 3i + c of column j of P_k; restricted to the free
   // DOFs, both index maps are ascending, so each column is written in place in P_k's row order.
   for (int k = 0; k + 1 < levels; ++k) {
@@ -435,16 +468,51 @@ struct MultigridPreconditioner::Coarse {
   Index nonzeros = -1;
 };
 
+struct MultigridCoarseLevels {
+  /// Every level of the hierarchy they came from but the finest, coarsest first.
+  std::vector<std::unique_ptr<MultigridPreconditioner::Level>> levels;
+  std::unique_ptr<MultigridPreconditioner::Coarse> coarse;
+  /// The prolongations between them (P_0 … P_{L−2}) and the keys of their unknowns.
+  std::vector<SparseMatrixd> prolongations;
+  std::vector<std::vector<std::int64_t>> keys;
+  double iterations_per_decade = -1.0;
+};
+
+namespace {
+
+bool same_matrix(const SparseMatrixd& a, const SparseMatrixd& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros() ||
+      !a.isCompressed() || !b.isCompressed())
+    return false;
+  const auto n = static_cast<std::size_t>(a.nonZeros());
+  return std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1, b.outerIndexPtr()) &&
+         std::equal(a.innerIndexPtr(), a.innerIndexPtr() + n, b.innerIndexPtr()) &&
+         std::equal(a.valuePtr(), a.valuePtr() + n, b.valuePtr());
+}
+
+}  // namespace
+
 MultigridPreconditioner::MultigridPreconditioner(std::vector<SparseMatrixd> prolongations,
-                                                 Options options)
+                                                 Options options,
+                                                 std::vector<std::vector<std::int64_t>> coarse_keys)
     : m_options(options),
       m_prolongations(std::move(prolongations)),
-      m_coarse(std::make_unique<Coarse>()) {
+      m_coarse(std::make_unique<Coarse>()),
+      m_coarse_keys(std::move(coarse_keys)) {
   if (m_options.smoothing_degree < 1)
     throw std::invalid_argument("MultigridPreconditioner: smoothing_degree must be >= 1");
   for (std::size_t k = 0; k + 1 < m_prolongations.size(); ++k)
     if (m_prolongations[k + 1].cols() != m_prolongations[k].rows())
       throw std::invalid_argument("MultigridPreconditioner: prolongation sizes do not chain");
+  if (!m_coarse_keys.empty()) {
+    if (m_coarse_keys.size() != m_prolongations.size())
+      throw std::invalid_argument(
+          "MultigridPreconditioner: one key list per coarse level expected");
+    for (std::size_t k = 0; k < m_coarse_keys.size(); ++k)
+      if (static_cast<Index>(m_coarse_keys[k].size()) != m_prolongations[k].cols())
+        throw std::invalid_argument("MultigridPreconditioner: key list " + std::to_string(k) +
+                                    " has the wrong size");
+  }
   for (const SparseMatrixd& P : m_prolongations)
     m_prolongation_rows.emplace_back(P);
   m_levels.resize(m_prolongations.size() + 1);
@@ -461,7 +529,7 @@ std::vector<Index> MultigridPreconditioner::level_sizes() const {
 
 bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   const auto start = std::chrono::steady_clock::now();
-  // A seed serves this setup, whatever its outcome.
+  // A seed and offered levels serve this setup, whatever its outcome.
   const std::vector<SmootherEstimate> pending_seed = std::move(m_seed);
   m_seed.clear();
   const int L = num_levels() - 1;
@@ -469,6 +537,33 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     throw std::invalid_argument("MultigridPreconditioner::setup: matrix has " +
                                 std::to_string(A.rows()) + " rows, the finest level " +
                                 std::to_string(m_prolongations.back().rows()));
+  m_carried_iterations_per_decade = -1.0;
+  m_carried_setup = take_offered_levels(std::move(m_offered));
+  m_offered.reset();
+  if (m_carried_setup) {
+    // The coarse levels are the offered ones: only the finest level is set up.
+    Level& finest = *m_levels[L];
+    finest.A = &A;
+    finest.owned.resize(0, 0);
+    finest.blocks.clear();
+    finest.blocks.keep_single_precision(A.nonZeros() / 9 >= m_options.single_precision_min_blocks);
+    finest.blocks.assign(A);
+    SmootherEstimate seed;
+    if (static_cast<int>(pending_seed.size()) == L) {
+      const SmootherEstimate& offered = pending_seed[L - 1];
+      if (offered.lambda > 0.0 && std::isfinite(offered.lambda) && offered.rows > 0 &&
+          2 * offered.rows >= A.rows() && offered.rows <= 2 * A.rows())
+        seed = offered;
+    }
+    m_seeded_setup = seed.lambda > 0.0;
+    setup_smoother(finest, seed);
+    m_sizes.clear();
+    for (const auto& level : m_levels)
+      m_sizes.push_back(level->A->rows());
+    m_setup_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return m_coarse->llt.info() == Eigen::Success;
+  }
   for (auto& level : m_levels)
     level->blocks.clear();  // copied anew below
   m_levels[L]->A = &A;
@@ -514,6 +609,49 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   m_coarse->llt.factorize(A0);
   m_setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return m_coarse->llt.info() == Eigen::Success;
+}
+
+std::shared_ptr<MultigridCoarseLevels> MultigridPreconditioner::release_coarse_levels(
+    double iterations_per_decade) {
+  const int L = num_levels() - 1;
+  if (m_sizes.empty() || L < 1 || m_coarse_keys.empty()) return nullptr;
+  auto released = std::make_shared<MultigridCoarseLevels>();
+  for (int k = 0; k < L; ++k) {
+    released->levels.push_back(std::move(m_levels[k]));
+    m_levels[k] = std::make_unique<Level>();
+  }
+  released->coarse = std::move(m_coarse);
+  m_coarse = std::make_unique<Coarse>();
+  m_coarse->llt.cholmod().print = 0;
+  released->prolongations.assign(m_prolongations.begin(), m_prolongations.end() - 1);
+  released->keys = m_coarse_keys;
+  released->iterations_per_decade = iterations_per_decade;
+  m_sizes.clear();  // set up anew before the next use
+  return released;
+}
+
+void MultigridPreconditioner::offer_coarse_levels(std::shared_ptr<MultigridCoarseLevels> levels) {
+  m_offered = std::move(levels);
+}
+
+bool MultigridPreconditioner::take_offered_levels(std::shared_ptr<MultigridCoarseLevels> offered) {
+  const int L = num_levels() - 1;
+  if (offered == nullptr || L < 1 || m_coarse_keys.empty()) return false;
+  MultigridCoarseLevels& levels = *offered;
+  // Levels that were given up or taken already have no coarse factor.
+  if (levels.coarse == nullptr || static_cast<int>(levels.levels.size()) != L ||
+      levels.keys != m_coarse_keys || static_cast<int>(levels.prolongations.size()) != L - 1)
+    return false;
+  for (int k = 0; k + 1 < L; ++k)
+    if (!same_matrix(levels.prolongations[k], m_prolongations[k])) return false;
+  for (int k = 0; k < L; ++k) {
+    m_levels[k] = std::move(levels.levels[k]);
+    m_levels[k]->A = &m_levels[k]->owned;
+  }
+  m_coarse = std::move(levels.coarse);
+  m_carried_iterations_per_decade = levels.iterations_per_decade;
+  levels.levels.clear();
+  return true;
 }
 
 void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {

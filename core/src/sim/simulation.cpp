@@ -129,6 +129,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
     options.nested_spaces.check();
     m_nested = std::move(options.nested_spaces);
     m_smoother_seed = std::move(options.smoother_estimates);
+    m_coarse_seed = std::move(options.coarse_levels);
   }
   if (m_material.plasticity) {
     m_plastic = PlasticState::identity(m_mesh.tets.rows());
@@ -199,6 +200,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .ground_stiffness = m_ground_stiffness,
                              .nested_spaces = m_nested.empty() ? nullptr : &m_nested,
                              .smoother_estimates = &m_smoother_seed,
+                             .coarse_levels = &m_coarse_seed,
                              .timed_forces = &m_timed,
                              .springs = m_springs.get(),
                              .obstacles = &m_obstacles,
@@ -206,6 +208,7 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
                              .contact = contact});
   m_build_seconds.problem = lap(phase);
   m_stepper = m_stepper_traits->make(*m_system, m_settings);
+  m_coarse_seed.reset();  // the solver holds them now, until its first setup
   m_build_seconds.stepper = lap(phase);
   if (is_static()) {
     if (m_steps > 0) apply_dirichlet(m_groups, m_x, load_factor(), load_factor(), 0.0, m_x, m_v);
@@ -608,6 +611,11 @@ std::vector<SmootherEstimate> Simulation::smoother_estimates() const {
   return solver != nullptr ? solver->smoother_estimates() : std::vector<SmootherEstimate>{};
 }
 
+std::shared_ptr<MultigridCoarseLevels> Simulation::release_coarse_levels() {
+  SpdSolver* solver = m_stepper->linear_solver();
+  return solver != nullptr ? solver->release_coarse_levels() : nullptr;
+}
+
 SimulationCounters Simulation::counters() const {
   SimulationCounters counters = m_newton;
   counters.steps = m_steps - m_first_step;
@@ -618,6 +626,7 @@ SimulationCounters Simulation::counters() const {
     counters.linear_iterations = solver->cg_iterations();
     counters.reused_factor_solves = solver->reused_factor_solves();
     counters.multigrid_setups = solver->multigrid_setups();
+    counters.multigrid_carried_setups = solver->carried_setups();
     counters.multigrid_setup_seconds = solver->multigrid_setup_seconds();
     counters.multigrid_direct_fallbacks = solver->direct_fallbacks();
     counters.linear_solver = solver->kind();

@@ -224,6 +224,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
                          {"transfer", change.phases.transfer},
                          {"records", change.phases.records}}},
                        {"multigrid_setups", change.multigrid_setups},
+                       {"multigrid_carried_setups", change.multigrid_carried_setups},
                        {"multigrid_setup_seconds", change.multigrid_setup_seconds},
                        {"plastic_merge_change", change.plastic_merge_change},
                        {"contact_correction", change.contact_correction}});
@@ -291,6 +292,7 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
                      {"max_residual_ratio", counters.max_residual_ratio},
                      {"linear_solver", to_string(counters.linear_solver)},
                      {"multigrid_setups", counters.multigrid_setups},
+                     {"multigrid_carried_setups", counters.multigrid_carried_setups},
                      {"multigrid_setup_seconds", counters.multigrid_setup_seconds},
                      {"multigrid_direct_fallbacks", counters.multigrid_direct_fallbacks}};
   if (counters.stalled_steps > 0)

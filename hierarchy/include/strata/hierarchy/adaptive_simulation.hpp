@@ -158,6 +158,9 @@ struct CutChangeRecord {
   /// stale) and their wall time [s]. Not in `seconds`: the steps on the cut include them.
   long multigrid_setups = 0;
   double multigrid_setup_seconds = 0.0;
+  /// Of those, the setups that kept the previous cut's coarse levels (the new cut's coarse spaces
+  /// were the same) and set up only the finest level.
+  long multigrid_carried_setups = 0;
   /// Plastic materials: largest |ε̄ₚ(child) − ε̄ₚ(parent)| over the merges of this change (the
   /// detail a merge averages away; 0 without merges or plasticity).
   double plastic_merge_change = 0.0;
@@ -299,8 +302,10 @@ class AdaptiveSimulation final : public SimulationRun {
   /// returns the options of a Simulation on it that starts at `first_step`.
   SimulationOptions flatten(long first_step);
   /// flatten() and a new Simulation on the cut, its multigrid seeded with `smoother_estimates`
-  /// (SimulationOptions); m_mesh_external follows. Returns the flattening's seconds.
-  double rebuild(long first_step, std::vector<SmootherEstimate> smoother_estimates = {});
+  /// and offered `coarse_levels` (SimulationOptions); m_mesh_external follows. Returns the
+  /// flattening's seconds.
+  double rebuild(long first_step, std::vector<SmootherEstimate> smoother_estimates = {},
+                 std::shared_ptr<MultigridCoarseLevels> coarse_levels = {});
   /// *m_simulation; throws std::logic_error when a failed cut change left none.
   const Simulation& live() const;
   /// One decision and its cut change; a positive `calibration_target` refines against it instead

@@ -16,6 +16,10 @@
 /// Levels that would shrink the space by less than a factor 1/0.7 (a cut refined only locally) are
 /// merged into the next finer one (their prolongations multiplied), so every coarse level pays
 /// for itself.
+///
+/// Each coarse space's keys (NestedSpaces::keys) are its vertices' tree vertex ids: two cuts of
+/// one tree whose coarse spaces have the same keys and prolongations have the same coarse levels,
+/// which a cut change then carries over (MultigridPreconditioner::offer_coarse_levels).
 #include "strata/core/sim/multigrid.hpp"
 #include "strata/hierarchy/hanging_constraints.hpp"
 

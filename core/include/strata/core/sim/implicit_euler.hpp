@@ -32,6 +32,7 @@ class ImplicitEuler {
 
   const EnergySum& energy() const { return m_energy; }
   const SpdSolver& linear_solver() const { return m_solver; }
+  SpdSolver& linear_solver() { return m_solver; }
 
  private:
   const Problem& m_problem;

@@ -67,8 +67,14 @@ class SpdSolver {
   /// of the tree's multigrid (MultigridPreconditioner::seed_smoother_estimates); should PCG not
   /// converge on that hierarchy, it is set up again with measured estimates before CHOLMOD is
   /// asked.
+  /// `coarse_levels` (a previous solver's release_coarse_levels()) are offered to that first
+  /// setup (MultigridPreconditioner::offer_coarse_levels): where the coarse spaces are the same,
+  /// it sets up only the finest level, and the hierarchy counts as stale once PCG needs more than
+  /// twice the iterations per decade of residual reduction that it needed on the hierarchy that
+  /// computed those levels.
   void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs,
-                         std::vector<SmootherEstimate> smoother_estimates = {});
+                         std::vector<SmootherEstimate> smoother_estimates = {},
+                         std::shared_ptr<MultigridCoarseLevels> coarse_levels = {});
 
   /// Relative residual ‖b − A x‖ / ‖b‖ at which the iterative paths (CG on a previous factor,
   /// multigrid-PCG) stop; default 10⁻¹⁰. Newton sets it per solve (inexact Newton).
@@ -97,6 +103,12 @@ class SpdSolver {
   /// The smoothers' Lanczos estimates of the tree's multigrid as of its last setup (empty for
   /// other solvers or before a setup).
   std::vector<SmootherEstimate> smoother_estimates() const;
+  /// The coarse levels of the tree multigrid's last setup, given up for a solver built next on a
+  /// nearby system (use_nested_spaces); this solver sets up anew at its next solve. Null for
+  /// other solvers, before a setup, or when the hierarchy is due to be set up anew.
+  std::shared_ptr<MultigridCoarseLevels> release_coarse_levels();
+  /// Setups that took a previous solver's coarse levels (counted in multigrid_setups too).
+  long carried_setups() const { return m_carried_setups; }
   /// Flops of a Cholesky factorisation per non-zero of A, from the last symbolic analysis (0
   /// before any): the cost `automatic` compares with kAlgebraicMultigridMinFill.
   double factor_flops_per_nonzero() const { return m_factor_flops_per_nonzero; }
@@ -130,6 +142,7 @@ class SpdSolver {
   Index m_multigrid_nonzeros = -1;
   long m_direct_fallbacks = 0;
   long m_multigrid_setups = 0;
+  long m_carried_setups = 0;
   double m_multigrid_setup_seconds = 0.0;
   bool m_multigrid_stale = true;
   double m_iterations_per_decade = -1.0;  ///< of the first solve after the last setup

@@ -21,6 +21,7 @@
 /// when λ_max(D⁻¹A) < 1.25 λ̂ (the polynomial's bound). The Lanczos estimate is within a few
 /// per cent in practice; a cycle that is not positive definite shows as rᵀz ≤ 0 in PCG, which sets
 /// up anew. Matrix–vector products and the smoothers run on TBB threads.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <utility>
@@ -40,13 +41,19 @@ struct NestedSpaces {
   /// injections[k][j]: the vertex of space k+1 that coarse vertex j of space k is (its row of
   /// prolongations[k] is the unit row e_j).
   std::vector<std::vector<Index>> injections;
+  /// keys[k][j]: what coarse vertex j of space k is, in terms that outlast this mesh (for the
+  /// tree's levels: its tree vertex), so that a hierarchy built on the next mesh knows its coarse
+  /// spaces for the same ones (MultigridPreconditioner::offer_coarse_levels). Empty: no keys, and
+  /// no coarse levels are passed on.
+  std::vector<std::vector<std::int64_t>> keys;
 
   bool empty() const { return prolongations.empty(); }
   /// Number of spaces including the finest (0 when empty).
   int num_levels() const { return empty() ? 0 : static_cast<int>(prolongations.size()) + 1; }
   /// Vertices of the finest space (the model's DOF vertices).
   Index num_fine_vertices() const { return empty() ? 0 : prolongations.back().rows(); }
-  /// Throws std::invalid_argument unless sizes chain and every injection is a unit row.
+  /// Throws std::invalid_argument unless sizes chain, every injection is a unit row and the keys,
+  /// when given, are one per coarse vertex.
   void check() const;
 };
 
@@ -54,6 +61,10 @@ struct NestedSpaces {
 /// system whose free DOFs are `free_dofs` (ascending indices into 3 · spaces.num_fine_vertices()).
 std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
                                                   const std::vector<Index>& free_dofs);
+/// The keys of the free DOFs of each coarse space (coarsest first; 3 · vertex key + coordinate,
+/// in the order of free_dof_prolongations' columns); empty when `spaces` has no keys.
+std::vector<std::vector<std::int64_t>> free_dof_keys(const NestedSpaces& spaces,
+                                                     const std::vector<Index>& free_dofs);
 
 /// y = A x for a symmetric A stored with both triangles (column-major), in parallel over columns.
 void symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y);
@@ -102,14 +113,22 @@ struct SmootherEstimate {
   double lambda = 0.0;
 };
 
+/// The coarse levels of a tree multigrid's setup — operators, smoothers and coarsest factor, with
+/// the keys of their unknowns — passed on to a hierarchy built next on a nearby system
+/// (MultigridPreconditioner::release_coarse_levels, offer_coarse_levels). Defined in the source.
+struct MultigridCoarseLevels;
+
 class MultigridPreconditioner {
  public:
   using Options = MultigridOptions;
 
   /// `prolongations`: DOF prolongations, coarsest first (see free_dof_prolongations); the last
   /// one's rows are the unknowns of the systems to precondition.
+  /// `coarse_keys`: the keys of each coarse level's unknowns (free_dof_keys), coarsest first;
+  /// empty: none (the hierarchy neither passes on nor takes coarse levels).
   explicit MultigridPreconditioner(std::vector<SparseMatrixd> prolongations,
-                                   Options options = Options());
+                                   Options options = Options(),
+                                   std::vector<std::vector<std::int64_t>> coarse_keys = {});
   ~MultigridPreconditioner();
   MultigridPreconditioner(const MultigridPreconditioner&) = delete;
   MultigridPreconditioner& operator=(const MultigridPreconditioner&) = delete;
@@ -155,6 +174,23 @@ class MultigridPreconditioner {
   /// Whether the last setup() took a seeded estimate on any level.
   bool seeded_setup() const { return m_seeded_setup; }
 
+  /// Gives up the coarse levels of the last setup() (every level but the finest, and the
+  /// coarsest factor) for a hierarchy built next on a nearby system, with `iterations_per_decade`
+  /// (the caller's measure of this hierarchy's PCG rate when it was fresh, −1: none) stored with
+  /// them. This hierarchy then needs setup() before its next use. Null before a setup, with a
+  /// single level or without coarse keys.
+  std::shared_ptr<MultigridCoarseLevels> release_coarse_levels(double iterations_per_decade = -1.0);
+  /// The next setup() takes `levels` (release_coarse_levels of a previous hierarchy) as its
+  /// coarse levels when its own have unknowns of the same keys in the same order at every coarse
+  /// level and the same prolongations between them: it then only sets up the finest level (its
+  /// block copy and smoother; the Galerkin operator below it stays the previous system's, as the
+  /// coarse levels stay after update_finest()). Otherwise setup() computes its own and drops
+  /// them. Either way the levels are taken from `levels`, which is left empty.
+  void offer_coarse_levels(std::shared_ptr<MultigridCoarseLevels> levels);
+  /// Whether the last setup() took offered coarse levels, and the rate stored with them.
+  bool carried_setup() const { return m_carried_setup; }
+  double carried_iterations_per_decade() const { return m_carried_iterations_per_decade; }
+
   int num_levels() const { return static_cast<int>(m_levels.size()); }
   /// The Chebyshev interval [λ_min, λ_max] of level k's smoother (D⁻¹A; k ≥ 1) and whether its
   /// products use the 3 × 3-block copy, as of the last setup (for tests and diagnostics).
@@ -187,6 +223,14 @@ class MultigridPreconditioner {
   std::vector<Index> m_sizes;            ///< unknowns per level at the last setup
   std::vector<SmootherEstimate> m_seed;  ///< for the next setup (seed_smoother_estimates)
   bool m_seeded_setup = false;
+  std::vector<std::vector<std::int64_t>> m_coarse_keys;  ///< per coarse level, coarsest first
+  std::shared_ptr<MultigridCoarseLevels> m_offered;      ///< for the next setup
+  bool m_carried_setup = false;
+  double m_carried_iterations_per_decade = -1.0;
+  /// Takes m_offered's levels where they fit this hierarchy (offer_coarse_levels).
+  bool take_offered_levels(std::shared_ptr<MultigridCoarseLevels> offered);
+
+  friend struct MultigridCoarseLevels;
   double m_setup_seconds = 0.0;
 };
 

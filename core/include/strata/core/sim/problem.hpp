@@ -15,6 +15,7 @@
 /// Built with designated initialisers; the referenced data must outlive the Problem:
 ///   Problem problem{.model = m, .dof_mass = M, .external_forces = f, .groups = g,
 ///                   .constrained = c, .ramp_time = T, .diagonal = d};
+#include <memory>
 #include <vector>
 
 #include "strata/core/common/types.hpp"
@@ -50,6 +51,9 @@ struct Problem {
   /// Smoother estimates from a hierarchy on a nearby system for the first multigrid setup on
   /// nested_spaces (MultigridPreconditioner::seed_smoother_estimates); null or empty: none.
   const std::vector<SmootherEstimate>* smoother_estimates = nullptr;
+  /// Coarse levels of a hierarchy on a nearby system offered to that first setup
+  /// (SpdSolver::use_nested_spaces); null or empty: none.
+  const std::shared_ptr<MultigridCoarseLevels>* coarse_levels = nullptr;
   /// Loads that follow their own amplitude s_k(t) (3·#Q each); null or empty: none.
   const std::vector<TimedForces>* timed_forces = nullptr;
   /// Surface springs on the DOF vertices (meshes without an embedding); null: none.

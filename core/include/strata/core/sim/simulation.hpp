@@ -88,6 +88,10 @@ struct SimulationOptions {
   /// The smoother estimates of a multigrid hierarchy on a nearby system (the previous cut:
   /// Simulation::smoother_estimates) for the first setup on `nested_spaces`; empty: measured.
   std::vector<SmootherEstimate> smoother_estimates;
+  /// The coarse levels of that hierarchy (Simulation::release_coarse_levels), taken by the first
+  /// setup on `nested_spaces` where its coarse spaces are the same (SpdSolver::use_nested_spaces);
+  /// null: computed.
+  std::shared_ptr<MultigridCoarseLevels> coarse_levels;
   /// Plastic state per mesh tet to start from (material with plasticity only); empty: virgin
   /// material (Fₚ = I, ε̄ₚ = 0).
   PlasticState plastic_state;
@@ -114,13 +118,15 @@ struct SimulationOptions {
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
 struct SimulationCounters {
-  long steps = 0;                        ///< time or load steps taken
-  long newton_iterations = 0;            ///< over all implicit / static steps
-  long long element_evaluations = 0;     ///< from ElasticModel
-  long factorizations = 0;               ///< numeric factorisations (or CG setups)
-  long linear_iterations = 0;            ///< CG iterations (incl. those on a previous factor)
-  long reused_factor_solves = 0;         ///< linear solves answered without a new factorisation
-  long multigrid_setups = 0;             ///< multigrid hierarchies built (multigrid only)
+  long steps = 0;                     ///< time or load steps taken
+  long newton_iterations = 0;         ///< over all implicit / static steps
+  long long element_evaluations = 0;  ///< from ElasticModel
+  long factorizations = 0;            ///< numeric factorisations (or CG setups)
+  long linear_iterations = 0;         ///< CG iterations (incl. those on a previous factor)
+  long reused_factor_solves = 0;      ///< linear solves answered without a new factorisation
+  long multigrid_setups = 0;          ///< multigrid hierarchies built (multigrid only)
+  /// of which set up only their finest level on a previous hierarchy's coarse levels
+  long multigrid_carried_setups = 0;
   double multigrid_setup_seconds = 0.0;  ///< their wall time [s]
   long multigrid_direct_fallbacks = 0;   ///< multigrid solves finished by CHOLMOD
   /// Linear solver of the Newton steps (automatic resolved; over several cuts, that of the
@@ -208,6 +214,10 @@ class Simulation final : public SimulationRun {
   /// The smoother estimates of the tree multigrid's last setup (empty without one), for a
   /// Simulation built next on a nearby system (SimulationOptions::smoother_estimates).
   std::vector<SmootherEstimate> smoother_estimates() const;
+  /// The coarse levels of the tree multigrid's last setup, given up for a Simulation built next
+  /// on a nearby system (SimulationOptions::coarse_levels); this one sets up anew at its next
+  /// solve. Null without them (SpdSolver::release_coarse_levels).
+  std::shared_ptr<MultigridCoarseLevels> release_coarse_levels();
   /// A plain run is its own current simulation.
   const Simulation& current() const override { return *this; }
 
@@ -306,6 +316,8 @@ class Simulation final : public SimulationRun {
   DivergenceLimits m_limits;
   NestedSpaces m_nested;
   std::vector<SmootherEstimate> m_smoother_seed;  ///< SimulationOptions::smoother_estimates
+  /// SimulationOptions::coarse_levels, until the stepper's solver has them.
+  std::shared_ptr<MultigridCoarseLevels> m_coarse_seed;
   std::unique_ptr<Problem> m_system;
   const StepperTraits* m_stepper_traits = nullptr;
   std::unique_ptr<TimeStepper> m_stepper;

@@ -39,6 +39,7 @@ class StaticSolver {
 
   const EnergySum& energy() const { return m_energy; }
   const SpdSolver& linear_solver() const { return m_solver; }
+  SpdSolver& linear_solver() { return m_solver; }
 
  private:
   const Problem& m_problem;

@@ -13,6 +13,7 @@ class BackwardEulerStepper final : public TimeStepper {
   BackwardEulerStepper(const Problem& problem, const SolverSettings& settings);
   NewtonResult step(double t0, double t1, double h, VectorXd& q, VectorXd& v) override;
   const SpdSolver* linear_solver() const override { return &m_integrator.linear_solver(); }
+  SpdSolver* linear_solver() override { return &m_integrator.linear_solver(); }
   const EnergySum* energy() const override { return &m_integrator.energy(); }
 
  private:

@@ -16,6 +16,7 @@ class StaticLoadStepper final : public TimeStepper {
                        const VectorXd& contact_reference) override;
   void reset_history() override { m_has_previous = false; }
   const SpdSolver* linear_solver() const override { return &m_solver.linear_solver(); }
+  SpdSolver* linear_solver() override { return &m_solver.linear_solver(); }
   const EnergySum* energy() const override { return &m_solver.energy(); }
 
  private:

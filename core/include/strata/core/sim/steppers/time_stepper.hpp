@@ -44,6 +44,7 @@ class TimeStepper {
   }
   /// The linear solver of implicit steppers; nullptr for explicit ones.
   virtual const SpdSolver* linear_solver() const { return nullptr; }
+  virtual SpdSolver* linear_solver() { return nullptr; }
   /// The energy Newton minimises (implicit steppers); nullptr for explicit ones.
   virtual const EnergySum* energy() const { return nullptr; }
 };
