@@ -348,8 +348,8 @@ TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
       EXPECT_LE(recorded, counters.multigrid_setups);
       EXPECT_GE(carried, 1);
       EXPECT_EQ(counters.multigrid_carried_setups, carried);
-      RecordProperty("carried setups", std::to_string(carried) + " of " +
-                                           std::to_string(recorded) + " after cut changes");
+      RecordProperty("carried setups", std::to_string(carried) + " of " + std::to_string(recorded) +
+                                           " after cut changes");
     } else {
       EXPECT_EQ(counters.multigrid_setups, 0);
       EXPECT_EQ(carried, 0);
