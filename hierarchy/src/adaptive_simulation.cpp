@@ -829,7 +829,8 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
 
   // The smoothers' eigenvalue estimates carry over: the levels of the new cut are mostly those of
   // the old one, changed where the cut changed. So do the coarse levels, where the new cut's are
-  // the same (MultigridPreconditioner::offer_coarse_levels).
+  // the same (MultigridPreconditioner::offer_coarse_levels): their keys are tree vertex ids, which
+  // stay unambiguous because the merged subtrees are released only after the rebuild below.
   std::vector<SmootherEstimate> smoother_estimates = m_simulation->smoother_estimates();
   std::shared_ptr<MultigridCoarseLevels> coarse_levels = m_simulation->release_coarse_levels();
   std::unique_ptr<ConstrainedCut> old_cut = std::move(m_constrained);

@@ -64,7 +64,7 @@ std::vector<std::vector<Index>> free_indices(const NestedSpaces& spaces,
   free_index[levels - 1].assign(num_dofs, -1);
   for (std::size_t i = 0; i < free_dofs.size(); ++i) {
     if (free_dofs[i] < 0 || free_dofs[i] >= num_dofs || (i > 0 && free_dofs[i] <= free_dofs[i - 1]))
-      throw std::invalid_argument("free_dof_prolongations: free DOF " + std::to_string(i) +
+      throw std::invalid_argument("nested spaces: free DOF " + std::to_string(i) +
                                   " is not an ascending index below " + std::to_string(num_dofs));
     free_index[levels - 1][free_dofs[i]] = static_cast<Index>(i);
   }
@@ -480,6 +480,19 @@ struct MultigridCoarseLevels {
 
 namespace {
 
+/// The seed of smoothed level k (1 … L) of `rows` unknowns: seeds[k − 1] when there is one per
+/// smoothed level, its estimate is positive and finite and it was measured on a level within a
+/// factor 2 of this one's size; otherwise none (λ = 0: measure).
+SmootherEstimate usable_seed(const std::vector<SmootherEstimate>& seeds, int L, int k, Index rows) {
+  if (static_cast<int>(seeds.size()) != L) return {};
+  const SmootherEstimate& seed = seeds[k - 1];
+  if (seed.lambda > 0.0 && std::isfinite(seed.lambda) && seed.rows > 0 && 2 * seed.rows >= rows &&
+      seed.rows <= 2 * rows)
+    return seed;
+  return {};
+}
+
+/// Whether two compressed matrices are the same entry for entry (pattern and values).
 bool same_matrix(const SparseMatrixd& a, const SparseMatrixd& b) {
   if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros() ||
       !a.isCompressed() || !b.isCompressed())
@@ -537,27 +550,28 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
     throw std::invalid_argument("MultigridPreconditioner::setup: matrix has " +
                                 std::to_string(A.rows()) + " rows, the finest level " +
                                 std::to_string(m_prolongations.back().rows()));
+  m_sizes.clear();
+  m_carried_setup = m_offered != nullptr;
   m_carried_iterations_per_decade = -1.0;
-  m_carried_setup = take_offered_levels(std::move(m_offered));
-  m_offered.reset();
   if (m_carried_setup) {
-    // The coarse levels are the offered ones: only the finest level is set up.
+    // The coarse levels are the offered ones (offer_coarse_levels checked that they fit): only
+    // the finest level is set up.
+    const std::unique_ptr<MultigridCoarseLevels> offered = std::move(m_offered);
+    for (int k = 0; k < L; ++k)
+      m_levels[k] = std::move(offered->levels[k]);
+    m_coarse = std::move(offered->coarse);
+    // The factor is the previous hierarchy's; a later setup of this one analyses its own pattern.
+    m_coarse->analysed = false;
+    m_carried_iterations_per_decade = offered->iterations_per_decade;
     Level& finest = *m_levels[L];
     finest.A = &A;
     finest.owned.resize(0, 0);
     finest.blocks.clear();
     finest.blocks.keep_single_precision(A.nonZeros() / 9 >= m_options.single_precision_min_blocks);
     finest.blocks.assign(A);
-    SmootherEstimate seed;
-    if (static_cast<int>(pending_seed.size()) == L) {
-      const SmootherEstimate& offered = pending_seed[L - 1];
-      if (offered.lambda > 0.0 && std::isfinite(offered.lambda) && offered.rows > 0 &&
-          2 * offered.rows >= A.rows() && offered.rows <= 2 * A.rows())
-        seed = offered;
-    }
+    const SmootherEstimate seed = usable_seed(pending_seed, L, L, A.rows());
     m_seeded_setup = seed.lambda > 0.0;
     setup_smoother(finest, seed);
-    m_sizes.clear();
     for (const auto& level : m_levels)
       m_sizes.push_back(level->A->rows());
     m_setup_seconds =
@@ -586,14 +600,7 @@ bool MultigridPreconditioner::setup(const SparseMatrixd& A) {
   }
   m_seeded_setup = false;
   for (int k = 1; k <= L; ++k) {
-    SmootherEstimate seed;
-    if (static_cast<int>(pending_seed.size()) == L) {
-      const Index rows = m_levels[k]->A->rows();
-      const SmootherEstimate& offered = pending_seed[k - 1];
-      if (offered.lambda > 0.0 && std::isfinite(offered.lambda) && offered.rows > 0 &&
-          2 * offered.rows >= rows && offered.rows <= 2 * rows)
-        seed = offered;
-    }
+    const SmootherEstimate seed = usable_seed(pending_seed, L, k, m_levels[k]->A->rows());
     m_seeded_setup = m_seeded_setup || seed.lambda > 0.0;
     setup_smoother(*m_levels[k], seed);
   }
@@ -615,43 +622,43 @@ std::shared_ptr<MultigridCoarseLevels> MultigridPreconditioner::release_coarse_l
     double iterations_per_decade) {
   const int L = num_levels() - 1;
   if (m_sizes.empty() || L < 1 || m_coarse_keys.empty()) return nullptr;
+  // What this hierarchy keeps, made before anything is moved.
+  std::vector<std::unique_ptr<Level>> emptied(L);
+  for (auto& level : emptied)
+    level = std::make_unique<Level>();
+  auto coarse = std::make_unique<Coarse>();
+  coarse->llt.cholmod().print = 0;
   auto released = std::make_shared<MultigridCoarseLevels>();
-  for (int k = 0; k < L; ++k) {
-    released->levels.push_back(std::move(m_levels[k]));
-    m_levels[k] = std::make_unique<Level>();
-  }
-  released->coarse = std::move(m_coarse);
-  m_coarse = std::make_unique<Coarse>();
-  m_coarse->llt.cholmod().print = 0;
   released->prolongations.assign(m_prolongations.begin(), m_prolongations.end() - 1);
   released->keys = m_coarse_keys;
   released->iterations_per_decade = iterations_per_decade;
-  m_sizes.clear();  // set up anew before the next use
+  for (int k = 0; k < L; ++k) {
+    released->levels.push_back(std::move(m_levels[k]));
+    m_levels[k] = std::move(emptied[k]);
+  }
+  released->coarse = std::move(m_coarse);
+  m_coarse = std::move(coarse);
+  // Nothing is left to apply: setup() before the next use (update_finest() throws until then).
+  m_sizes.clear();
+  Level& finest = *m_levels[L];
+  finest.A = nullptr;
+  finest.blocks.clear();
   return released;
 }
 
 void MultigridPreconditioner::offer_coarse_levels(std::shared_ptr<MultigridCoarseLevels> levels) {
-  m_offered = std::move(levels);
-}
-
-bool MultigridPreconditioner::take_offered_levels(std::shared_ptr<MultigridCoarseLevels> offered) {
+  m_offered.reset();
+  if (levels == nullptr) return;
+  auto taken = std::make_unique<MultigridCoarseLevels>(std::move(*levels));
+  *levels = MultigridCoarseLevels();
   const int L = num_levels() - 1;
-  if (offered == nullptr || L < 1 || m_coarse_keys.empty()) return false;
-  MultigridCoarseLevels& levels = *offered;
-  // Levels that were given up or taken already have no coarse factor.
-  if (levels.coarse == nullptr || static_cast<int>(levels.levels.size()) != L ||
-      levels.keys != m_coarse_keys || static_cast<int>(levels.prolongations.size()) != L - 1)
-    return false;
+  if (L < 1 || m_coarse_keys.empty() || taken->coarse == nullptr ||
+      static_cast<int>(taken->levels.size()) != L || taken->keys != m_coarse_keys ||
+      static_cast<int>(taken->prolongations.size()) != L - 1)
+    return;
   for (int k = 0; k + 1 < L; ++k)
-    if (!same_matrix(levels.prolongations[k], m_prolongations[k])) return false;
-  for (int k = 0; k < L; ++k) {
-    m_levels[k] = std::move(levels.levels[k]);
-    m_levels[k]->A = &m_levels[k]->owned;
-  }
-  m_coarse = std::move(levels.coarse);
-  m_carried_iterations_per_decade = levels.iterations_per_decade;
-  levels.levels.clear();
-  return true;
+    if (!same_matrix(taken->prolongations[k], m_prolongations[k])) return;
+  m_offered = std::move(taken);
 }
 
 void MultigridPreconditioner::update_finest(const SparseMatrixd& A) {

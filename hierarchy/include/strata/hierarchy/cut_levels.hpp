@@ -19,7 +19,9 @@
 ///
 /// Each coarse space's keys (NestedSpaces::keys) are its vertices' tree vertex ids: two cuts of
 /// one tree whose coarse spaces have the same keys and prolongations have the same coarse levels,
-/// which a cut change then carries over (MultigridPreconditioner::offer_coarse_levels).
+/// which a cut change then carries over (MultigridPreconditioner::offer_coarse_levels). The tree
+/// reuses the ids of vertices it releases, so keys compare only cuts whose vertices are all alive:
+/// a cut change flattens the new cut before the merged subtrees are released.
 #include "strata/core/sim/multigrid.hpp"
 #include "strata/hierarchy/hanging_constraints.hpp"
 

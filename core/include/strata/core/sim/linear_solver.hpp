@@ -15,7 +15,10 @@
 /// relative tolerance. The coarse operators of one setup serve the following solves
 /// (Newton matrices of one step, and of later steps, are close) until a solve needs more than
 /// twice the iterations per decade of residual reduction of the first solve after the setup
-/// (plus one), fails, or meets negative curvature; then the next solve sets up anew. The finest
+/// (plus one), fails, or meets negative curvature; then the next solve sets up anew. A setup that
+/// kept a previous solver's coarse levels (use_nested_spaces) compares with the first solve after
+/// the setup that computed them, and one that fails to converge is set up anew before CHOLMOD is
+/// asked. The finest
 /// level's smoother always uses the current matrix. When multigrid cannot solve a system (no
 /// convergence within 500 iterations on a fresh hierarchy, or a coarsest operator that does not
 /// factorise), CHOLMOD solves it (counted, direct_fallbacks): if A factorises, CHOLMOD takes every
@@ -70,8 +73,8 @@ class SpdSolver {
   /// `coarse_levels` (a previous solver's release_coarse_levels()) are offered to that first
   /// setup (MultigridPreconditioner::offer_coarse_levels): where the coarse spaces are the same,
   /// it sets up only the finest level, and the hierarchy counts as stale once PCG needs more than
-  /// twice the iterations per decade of residual reduction that it needed on the hierarchy that
-  /// computed those levels.
+  /// twice the iterations per decade of residual reduction, plus one, that it needed on the
+  /// hierarchy that computed those levels.
   void use_nested_spaces(const NestedSpaces* spaces, const std::vector<Index>& free_dofs,
                          std::vector<SmootherEstimate> smoother_estimates = {},
                          std::shared_ptr<MultigridCoarseLevels> coarse_levels = {});

@@ -180,12 +180,13 @@ class MultigridPreconditioner {
   /// them. This hierarchy then needs setup() before its next use. Null before a setup, with a
   /// single level or without coarse keys.
   std::shared_ptr<MultigridCoarseLevels> release_coarse_levels(double iterations_per_decade = -1.0);
-  /// The next setup() takes `levels` (release_coarse_levels of a previous hierarchy) as its
-  /// coarse levels when its own have unknowns of the same keys in the same order at every coarse
-  /// level and the same prolongations between them: it then only sets up the finest level (its
-  /// block copy and smoother; the Galerkin operator below it stays the previous system's, as the
-  /// coarse levels stay after update_finest()). Otherwise setup() computes its own and drops
-  /// them. Either way the levels are taken from `levels`, which is left empty.
+  /// Offers `levels` (release_coarse_levels of a previous hierarchy, built with the same options)
+  /// to the next setup(). Where this hierarchy's coarse levels have unknowns of the same keys in
+  /// the same order and the same prolongations between them, they are kept for it: setup() then
+  /// sets up only the finest level (its block copy and smoother; the Galerkin operator below it
+  /// stays the previous system's, as the coarse levels stay after update_finest()). Otherwise they
+  /// are dropped now, and setup() computes its own. Either way `levels` is left empty: one
+  /// hierarchy takes them.
   void offer_coarse_levels(std::shared_ptr<MultigridCoarseLevels> levels);
   /// Whether the last setup() took offered coarse levels, and the rate stored with them.
   bool carried_setup() const { return m_carried_setup; }
@@ -224,14 +225,13 @@ class MultigridPreconditioner {
   std::vector<SmootherEstimate> m_seed;  ///< for the next setup (seed_smoother_estimates)
   bool m_seeded_setup = false;
   std::vector<std::vector<std::int64_t>> m_coarse_keys;  ///< per coarse level, coarsest first
-  std::shared_ptr<MultigridCoarseLevels> m_offered;      ///< for the next setup
+  /// Offered coarse levels that fit this hierarchy, for the next setup (offer_coarse_levels).
+  std::unique_ptr<MultigridCoarseLevels> m_offered;
   bool m_carried_setup = false;
   double m_carried_iterations_per_decade = -1.0;
-  /// Takes m_offered's levels where they fit this hierarchy (offer_coarse_levels).
-  bool take_offered_levels(std::shared_ptr<MultigridCoarseLevels> offered);
+  double m_setup_seconds = 0.0;
 
   friend struct MultigridCoarseLevels;
-  double m_setup_seconds = 0.0;
 };
 
 }  // namespace strata
