@@ -15,12 +15,7 @@ ImplicitEuler::ImplicitEuler(const Problem& problem, LinearSolverKind solver,
       m_reduction(problem.model.stiffness_pattern(), problem.constrained),
       m_controls(controls),
       m_energy(problem.model.stiffness_pattern()) {
-  m_solver.use_nested_spaces(
-      problem.nested_spaces, m_reduction.free_dofs(),
-      problem.smoother_estimates != nullptr ? *problem.smoother_estimates
-                                            : std::vector<SmootherEstimate>{},
-      problem.coarse_levels != nullptr ? *problem.coarse_levels
-                                       : std::shared_ptr<MultigridCoarseLevels>{});
+  problem.use_nested_spaces(m_solver, m_reduction.free_dofs());
   m_inertia = &m_energy.emplace<InertiaTerm>(problem.dof_mass);
   m_energy.emplace<ElasticTerm>(problem.model);
   if (problem.springs != nullptr) m_energy.emplace<SpringTerm>(problem.springs->springs());

@@ -174,8 +174,10 @@ void SpdSolver::use_nested_spaces(const NestedSpaces* spaces, const std::vector<
   m_free_dofs = free_dofs;
   if (multigrid) {
     m_kind = LinearSolverKind::multigrid;
-    m_multigrid = std::make_unique<TreeCycle>(free_dof_prolongations(*spaces, free_dofs),
-                                              m_cycle_options, free_dof_keys(*spaces, free_dofs));
+    std::vector<std::vector<std::int64_t>> keys;
+    std::vector<SparseMatrixd> prolongations = free_dof_prolongations(*spaces, free_dofs, &keys);
+    m_multigrid =
+        std::make_unique<TreeCycle>(std::move(prolongations), m_cycle_options, std::move(keys));
     if (!smoother_estimates.empty())
       m_multigrid->seed_smoother_estimates(std::move(smoother_estimates));
     if (coarse_levels != nullptr) m_multigrid->offer_coarse_levels(std::move(coarse_levels));

@@ -82,26 +82,21 @@ std::vector<std::vector<Index>> free_indices(const NestedSpaces& spaces,
 
 }  // namespace
 
-std::vector<std::vector<std::int64_t>> free_dof_keys(const NestedSpaces& spaces,
-                                                     const std::vector<Index>& free_dofs) {
-  std::vector<std::vector<std::int64_t>> result;
-  if (spaces.empty() || spaces.keys.empty()) return result;
-  const std::vector<std::vector<Index>> free_index = free_indices(spaces, free_dofs);
-  for (int k = 0; k + 1 < spaces.num_levels(); ++k) {
-    std::vector<std::int64_t>& keys = result.emplace_back();
-    for (std::size_t j = 0; j < spaces.keys[k].size(); ++j)
-      for (int c = 0; c < 3; ++c)
-        if (free_index[k][3 * j + c] >= 0) keys.push_back(3 * spaces.keys[k][j] + c);
-  }
-  return result;
-}
-
 std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
-                                                  const std::vector<Index>& free_dofs) {
+                                                  const std::vector<Index>& free_dofs,
+                                                  std::vector<std::vector<std::int64_t>>* keys) {
   std::vector<SparseMatrixd> result;
+  if (keys != nullptr) keys->clear();
   if (spaces.empty()) return result;
   const int levels = spaces.num_levels();
   const std::vector<std::vector<Index>> free_index = free_indices(spaces, free_dofs);
+  if (keys != nullptr && !spaces.keys.empty())
+    for (int k = 0; k + 1 < levels; ++k) {
+      std::vector<std::int64_t>& level_keys = keys->emplace_back();
+      for (std::size_t j = 0; j < spaces.keys[k].size(); ++j)
+        for (int c = 0; c < 3; ++c)
+          if (free_index[k][3 * j + c] >= 0) level_keys.push_back(3 * spaces.keys[k][j] + c);
+    }
   // Column 3j + c of P_k ⊗ I₃ holds the rows 3i + c of column j of P_k; restricted to the free
   // DOFs, both index maps are ascending, so each column is written in place in P_k's row order.
   for (int k = 0; k + 1 < levels; ++k) {

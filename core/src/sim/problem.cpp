@@ -3,8 +3,16 @@
 #include <algorithm>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/sim/linear_solver.hpp"
 
 namespace strata {
+
+void Problem::use_nested_spaces(SpdSolver& solver, const std::vector<Index>& free_dofs) const {
+  solver.use_nested_spaces(
+      nested_spaces, free_dofs,
+      smoother_estimates != nullptr ? *smoother_estimates : std::vector<SmootherEstimate>{},
+      coarse_levels != nullptr ? *coarse_levels : std::shared_ptr<MultigridCoarseLevels>{});
+}
 
 double Problem::ramp(double t) const {
   return std::clamp(t / ramp_time, 0.0, 1.0);

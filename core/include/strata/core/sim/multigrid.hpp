@@ -59,12 +59,12 @@ struct NestedSpaces {
 
 /// The DOF prolongations (P_k ⊗ I₃ restricted to free DOFs, coarsest first) of `spaces` for a
 /// system whose free DOFs are `free_dofs` (ascending indices into 3 · spaces.num_fine_vertices()).
-std::vector<SparseMatrixd> free_dof_prolongations(const NestedSpaces& spaces,
-                                                  const std::vector<Index>& free_dofs);
-/// The keys of the free DOFs of each coarse space (coarsest first; 3 · vertex key + coordinate,
-/// in the order of free_dof_prolongations' columns); empty when `spaces` has no keys.
-std::vector<std::vector<std::int64_t>> free_dof_keys(const NestedSpaces& spaces,
-                                                     const std::vector<Index>& free_dofs);
+/// With `keys`, also the keys of the free DOFs of each coarse space (coarsest first;
+/// 3 · vertex key + coordinate, in the order of the prolongations' columns), empty when `spaces`
+/// has no keys.
+std::vector<SparseMatrixd> free_dof_prolongations(
+    const NestedSpaces& spaces, const std::vector<Index>& free_dofs,
+    std::vector<std::vector<std::int64_t>>* keys = nullptr);
 
 /// y = A x for a symmetric A stored with both triangles (column-major), in parallel over columns.
 void symmetric_product(const SparseMatrixd& A, ConstRef<VectorXd> x, VectorXd& y);
@@ -124,8 +124,8 @@ class MultigridPreconditioner {
 
   /// `prolongations`: DOF prolongations, coarsest first (see free_dof_prolongations); the last
   /// one's rows are the unknowns of the systems to precondition.
-  /// `coarse_keys`: the keys of each coarse level's unknowns (free_dof_keys), coarsest first;
-  /// empty: none (the hierarchy neither passes on nor takes coarse levels).
+  /// `coarse_keys`: the keys of each coarse level's unknowns (free_dof_prolongations), coarsest
+  /// first; empty: none (the hierarchy neither passes on nor takes coarse levels).
   explicit MultigridPreconditioner(std::vector<SparseMatrixd> prolongations,
                                    Options options = Options(),
                                    std::vector<std::vector<std::int64_t>> coarse_keys = {});

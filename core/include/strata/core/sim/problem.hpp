@@ -29,6 +29,8 @@
 
 namespace strata {
 
+class SpdSolver;
+
 class EnergySum;
 
 struct Problem {
@@ -88,6 +90,9 @@ struct Problem {
                                                                 VectorXd& f_int) const;
   /// a = M⁻¹ (f_int + f_ext + f_damp); at Dirichlet DOFs the prescribed acceleration at time t.
   void accelerations(double t, const VectorXd& x, const VectorXd& v, VectorXd& a) const;
+  /// solver.use_nested_spaces with nested_spaces, the free DOFs of the implicit stepper's
+  /// reduction, and the smoother estimates and coarse levels offered to its first setup.
+  void use_nested_spaces(SpdSolver& solver, const std::vector<Index>& free_dofs) const;
 };
 
 }  // namespace strata
