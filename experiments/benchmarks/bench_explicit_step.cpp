@@ -29,12 +29,18 @@ void explicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
   settings.dt = 1e-6;
   settings.duration = 1e3;
   {
-    const Simulation probe(mesh, benchmark_material(material), {clamp}, {}, std::nullopt,
-                           Vector3d(0.0, 0.0, -9.81), settings);
+    const Simulation probe(mesh,
+                           {.material = benchmark_material(material),
+                            .dirichlet = {clamp},
+                            .gravity = Vector3d(0.0, 0.0, -9.81)},
+                           settings);
     settings.dt = 0.5 * probe.stable_dt_estimate();
   }
-  Simulation sim(mesh, benchmark_material(material), {clamp}, {}, std::nullopt,
-                 Vector3d(0.0, 0.0, -9.81), settings);
+  Simulation sim(mesh,
+                 {.material = benchmark_material(material),
+                  .dirichlet = {clamp},
+                  .gravity = Vector3d(0.0, 0.0, -9.81)},
+                 settings);
   sim.advance();  // warm-up
   const CpuSeconds cpu_start = process_cpu_seconds();
   for (auto _ : state) {

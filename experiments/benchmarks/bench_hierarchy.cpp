@@ -71,8 +71,11 @@ std::unique_ptr<AdaptiveSimulation> make_simulation(HierarchyMode mode,
                                                     const SolverSettings& solver) {
   const SlabScene scene = slab_scene();
   return std::make_unique<AdaptiveSimulation>(
-      scene.coarse, slab_hierarchy(mode), scene.material, std::vector<DirichletSpec>{scene.fixed},
-      std::vector<RegionLoad>{scene.press}, std::nullopt, Vector3d::Zero(), solver);
+      scene.coarse, slab_hierarchy(mode),
+      ProblemSpec{.material = scene.material,
+                  .dirichlet = std::vector<DirichletSpec>{scene.fixed},
+                  .loads = std::vector<RegionLoad>{scene.press}},
+      solver);
 }
 
 void report_cut(benchmark::State& state, const AdaptiveSimulation& simulation) {

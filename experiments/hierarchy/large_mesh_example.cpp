@@ -139,8 +139,8 @@ int run(const Options& options) {
   solver.dt = options.dt;
   solver.duration = options.steps * options.dt;
 
-  strata::AdaptiveSimulation simulation(coarse, hierarchy, material, {fixed}, {press}, std::nullopt,
-                                        Vector3d::Zero(), solver);
+  strata::AdaptiveSimulation simulation(
+      coarse, hierarchy, {.material = material, .dirichlet = {fixed}, .loads = {press}}, solver);
   const double setup_seconds = std::chrono::duration<double>(Clock::now() - setup_start).count();
 
   const std::uint64_t potential_leaves =

@@ -131,19 +131,18 @@ void validate_hierarchy_settings(const HierarchySettings& settings, const std::s
     throw InputError(where + ".cut: mode \"precomputed\" needs a precomputed cut");
 }
 
-AdaptiveSimulation::AdaptiveSimulation(
-    const TetMesh& coarse, const HierarchySettings& hierarchy, const Material& material,
-    std::vector<DirichletSpec> dirichlet, const std::vector<RegionLoad>& loads,
-    std::optional<GroundPlane> ground, const Vector3d& gravity, const SolverSettings& settings,
-    std::vector<Obstacle> obstacles, std::vector<RootPoint> contact_surface)
+AdaptiveSimulation::AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
+                                       ProblemSpec problem, const SolverSettings& settings,
+                                       std::vector<RootPoint> contact_surface)
     : m_settings(hierarchy),
-      m_material(material),
-      m_dirichlet(std::move(dirichlet)),
-      m_ground(std::move(ground)),
-      m_gravity(gravity),
+      m_material(std::move(problem.material)),
+      m_dirichlet(std::move(problem.dirichlet)),
+      m_ground(std::move(problem.ground)),
+      m_gravity(problem.gravity),
       m_solver(settings),
-      m_obstacles(std::move(obstacles)),
+      m_obstacles(std::move(problem.obstacles)),
       m_contact_surface(std::move(contact_surface)) {
+  const std::vector<RegionLoad>& loads = problem.loads;
   validate_hierarchy_settings(m_settings, "hierarchy");
   validate_material(m_material, "material");
   validate_solver_settings(m_solver, "solver");
@@ -298,9 +297,8 @@ void AdaptiveSimulation::initial_adaptation() {
     options.extra_mesh_forces = m_mesh_external;
     options.extra_timed_mesh_forces.clear();
     const auto static_solve = [&](bool warm) {
-      auto solve = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material,
-                                                peak_dirichlet, std::vector<RegionLoad>{}, m_ground,
-                                                m_gravity, statics, options);
+      auto solve = std::make_unique<Simulation>(m_constrained->flat.mesh,
+                                                cut_problem(peak_dirichlet), statics, options);
       if (warm) {
         const HangingConstraints& constraints = m_constrained->constraints;
         const VectorXd q = constraints.restrict_to_free(transfer_vertex_values(
@@ -529,8 +527,7 @@ double AdaptiveSimulation::rebuild(long first_step,
   options.coarse_levels = std::move(coarse_levels);
   const double flatten_seconds = seconds_since(start);
   m_mesh_external = peak_loads(options);
-  m_simulation = std::make_unique<Simulation>(m_constrained->flat.mesh, m_material, m_dirichlet,
-                                              std::vector<RegionLoad>{}, m_ground, m_gravity,
+  m_simulation = std::make_unique<Simulation>(m_constrained->flat.mesh, cut_problem(m_dirichlet),
                                               m_solver, std::move(options));
   m_mesh_external += gravity_forces(m_simulation->vertex_mass(), m_gravity);
   return flatten_seconds;
@@ -654,9 +651,17 @@ void AdaptiveSimulation::advance_with_redo() {
     adapt(0, false, true);
 }
 
+ProblemSpec AdaptiveSimulation::cut_problem(std::vector<DirichletSpec> dirichlet) const {
+  // The region loads are on the finest level, mapped to each cut (SimulationOptions).
+  return {.material = m_material,
+          .dirichlet = std::move(dirichlet),
+          .gravity = m_gravity,
+          .ground = m_ground,
+          .obstacles = m_obstacles};
+}
+
 void AdaptiveSimulation::add_contact(SimulationOptions& options) const {
   if (m_obstacles.empty()) return;
-  options.obstacles = m_obstacles;
   options.contact_stiffness = m_contact_stiffness;
   options.boundary_contact_points = !m_finest_contact;
   options.contact_points.clear();

@@ -157,8 +157,8 @@ TEST_P(UniaxialPlateau, PerfectPlasticityHoldsTheYieldStress) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 10;
-  Simulation sim(bar.mesh, plastic_material(GetParam(), 0.0), groups, {}, std::nullopt,
-                 Vector3d::Zero(), settings);
+  Simulation sim(bar.mesh, {.material = plastic_material(GetParam(), 0.0), .dirichlet = groups},
+                 settings);
   while (!sim.finished()) {
     sim.advance();
     const double strain = std::log1p(bar.end_displacement(sim) / kLength);
@@ -199,8 +199,11 @@ ForceCycle force_cycle(double peak_nominal_stress, double hardening) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 20;
-  Simulation sim(bar.mesh, plastic_material(MaterialModel::neohookean, hardening), bar.symmetry(),
-                 {pull}, std::nullopt, Vector3d::Zero(), settings);
+  Simulation sim(bar.mesh,
+                 {.material = plastic_material(MaterialModel::neohookean, hardening),
+                  .dirichlet = bar.symmetry(),
+                  .loads = {pull}},
+                 settings);
   ForceCycle cycle;
   while (!sim.finished()) {
     sim.advance();
@@ -255,7 +258,7 @@ TEST(UniaxialDynamic, ImplicitStepsHoldThePlateau) {
   SolverSettings settings;
   settings.dt = 0.02;
   settings.duration = 1.0;
-  Simulation sim(bar.mesh, material, groups, {}, std::nullopt, Vector3d::Zero(), settings);
+  Simulation sim(bar.mesh, {.material = material, .dirichlet = groups}, settings);
   while (!sim.finished())
     sim.advance();
   const TetFields fields = sim.model().tet_fields(sim.positions());

@@ -27,7 +27,7 @@ double tip_deflection(int cells_along, double load) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 1;
-  Simulation sim(mesh, material, {clamp}, {tip}, std::nullopt, Vector3d::Zero(), settings);
+  Simulation sim(mesh, {.material = material, .dirichlet = {clamp}, .loads = {tip}}, settings);
   while (!sim.finished())
     sim.advance();
   double sum = 0.0;

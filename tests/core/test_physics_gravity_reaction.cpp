@@ -25,7 +25,7 @@ TEST(SimPhysics, GravityLoadedColumnReactionBalancesTheWeight) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 2;
-  Simulation sim(mesh, material, {base}, {}, std::nullopt, gravity, settings);
+  Simulation sim(mesh, {.material = material, .dirichlet = {base}, .gravity = gravity}, settings);
   while (!sim.finished())
     sim.advance();
 

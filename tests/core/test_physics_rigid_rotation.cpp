@@ -30,7 +30,7 @@ TEST_P(RigidRotation, EndFaceRotationMovesTheBodyRigidly) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 4;
-  Simulation sim(mesh, material, {twist}, {}, std::nullopt, Vector3d::Zero(), settings);
+  Simulation sim(mesh, {.material = material, .dirichlet = {twist}}, settings);
   while (!sim.finished())
     sim.advance();
 

@@ -44,7 +44,7 @@ TEST_P(UniaxialTension, PoissonRatioAndYoungsModulusAreRecovered) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 1;
-  Simulation sim(mesh, material, groups, {}, std::nullopt, Vector3d::Zero(), settings);
+  Simulation sim(mesh, {.material = material, .dirichlet = groups}, settings);
   while (!sim.finished())
     sim.advance();
 

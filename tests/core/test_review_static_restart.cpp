@@ -74,8 +74,12 @@ TEST(ReviewStaticRestart, ResolvingTheLastStepOnARestartContinuesThePath) {
   settings.load_steps = 6;
   const GroundPlane ground{Vector3d(0, 0, -0.05), Vector3d::UnitZ()};
   const Vector3d gravity(0, 0, -9.81);
-  Simulation reference(bar.mesh, soft_rubber(), clamp_and_push(), {}, ground, gravity, settings,
-                       bar.options);
+  Simulation reference(bar.mesh,
+                       {.material = soft_rubber(),
+                        .dirichlet = clamp_and_push(),
+                        .gravity = gravity,
+                        .ground = ground},
+                       settings, bar.options);
   for (int k = 0; k < 3; ++k)
     reference.advance();
   const VectorXd q3 = reference.dof_positions();
@@ -85,8 +89,12 @@ TEST(ReviewStaticRestart, ResolvingTheLastStepOnARestartContinuesThePath) {
   // The adaptive driver's restart: first_step = k − 1 from the state of step k, then re-solve k.
   SimulationOptions restart = bar.options;
   restart.first_step = 2;
-  Simulation resumed(bar.mesh, soft_rubber(), clamp_and_push(), {}, ground, gravity, settings,
-                     restart);
+  Simulation resumed(bar.mesh,
+                     {.material = soft_rubber(),
+                      .dirichlet = clamp_and_push(),
+                      .gravity = gravity,
+                      .ground = ground},
+                     settings, restart);
   EXPECT_DOUBLE_EQ(resumed.load_factor(), 2.0 / 6.0);
   resumed.set_state(q3, VectorXd::Zero(q3.size()));
   resumed.advance();

@@ -241,10 +241,12 @@ TEST(ContactScenes, BlockPressedOntoAPlaneCarriesTheLoad) {
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 4;
-  SimulationOptions options;
-  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
-  Simulation sim(cube(), rubber(), {roller}, {press}, std::nullopt, Vector3d::Zero(), settings,
-                 std::move(options));
+  Simulation sim(cube(),
+                 {.material = rubber(),
+                  .dirichlet = {roller},
+                  .loads = {press},
+                  .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+                 settings);
   while (!sim.finished())
     sim.advance();
   const VectorXd f = sim.contact_forces();
@@ -271,16 +273,17 @@ struct SlopeRun {
 SlopeRun slope(double degrees) {
   const double theta = degrees * std::numbers::pi / 180.0;
   const double g = 9.81;
-  SimulationOptions options;
-  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
-  options.obstacles[0].friction = 0.5;
+  Obstacle ground = plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ());
+  ground.friction = 0.5;
   SolverSettings settings;
   settings.dt = 1e-3;
   settings.duration = 0.35;
   const TetMesh mesh = cube();
-  Simulation sim(mesh, rubber(), {}, {}, std::nullopt,
-                 Vector3d(g * std::sin(theta), 0, -g * std::cos(theta)), settings,
-                 std::move(options));
+  Simulation sim(mesh,
+                 {.material = rubber(),
+                  .gravity = Vector3d(g * std::sin(theta), 0, -g * std::cos(theta)),
+                  .obstacles = {ground}},
+                 settings);
   const VectorXd& m = sim.vertex_mass();
   const auto centre = [&](const VectorXd& values) {
     Vector3d sum = Vector3d::Zero();
@@ -322,13 +325,14 @@ TEST(ContactScenes, BlockOnASlopeSlidesWithTheCoulombAcceleration) {
 TEST(ContactScenes, BlockDroppedOnASphereStaysWithinTheTolerance) {
   const TetMesh mesh =
       box_tet_mesh(Vector3d(-0.05, -0.05, 0.22), Vector3d(0.05, 0.05, 0.32), {2, 2, 2});
-  SimulationOptions options;
-  options.obstacles = {sphere_obstacle(Vector3d::Zero(), 0.2)};
   SolverSettings settings;
   settings.dt = 1e-3;
   settings.duration = 0.4;
-  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings,
-                 std::move(options));
+  Simulation sim(mesh,
+                 {.material = rubber(),
+                  .gravity = Vector3d(0, 0, -9.81),
+                  .obstacles = {sphere_obstacle(Vector3d::Zero(), 0.2)}},
+                 settings);
   double lowest = 1.0;
   while (!sim.finished()) {
     sim.advance();
@@ -347,7 +351,6 @@ TEST(ContactScenes, PointsBoundByWeightsCarryTheBodyWhereItsVerticesDoNotTouch) 
   // coarse mesh gets) touch the plane: they, not the vertices, hold it up.
   const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0.05), Vector3d(0.1, 0.1, 0.15), {1, 1, 1});
   SimulationOptions options;
-  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
   for (Index bottom = 0; bottom < mesh.vertices.rows(); ++bottom) {
     if (mesh.vertices(bottom, 2) > 0.05 + 1e-12) continue;
     for (Index top = 0; top < mesh.vertices.rows(); ++top)
@@ -362,8 +365,11 @@ TEST(ContactScenes, PointsBoundByWeightsCarryTheBodyWhereItsVerticesDoNotTouch) 
   settings.duration = 0.3;
   Material material = rubber();
   material.mass_damping = 20.0;  // settle
-  Simulation sim(mesh, material, {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings,
-                 std::move(options));
+  Simulation sim(mesh,
+                 {.material = material,
+                  .gravity = Vector3d(0, 0, -9.81),
+                  .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+                 settings, std::move(options));
   while (!sim.finished())
     sim.advance();
   double lowest = 1.0;
@@ -380,16 +386,17 @@ TEST(ContactScenes, PointsBoundByWeightsCarryTheBodyWhereItsVerticesDoNotTouch) 
 }
 
 TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
-  SimulationOptions options;
-  options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
   SolverSettings settings;
   settings.integrator = Integrator::symplectic_euler;
   settings.dt = 2e-5;
   settings.duration = 0.02;
   TetMesh mesh = cube();
   mesh.vertices.col(2).array() += 0.001;
-  Simulation sim(mesh, rubber(), {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings,
-                 std::move(options));
+  Simulation sim(mesh,
+                 {.material = rubber(),
+                  .gravity = Vector3d(0, 0, -9.81),
+                  .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+                 settings);
   VectorXd v = VectorXd::Zero(sim.dof_velocities().size());
   for (Index i = 2; i < v.size(); i += 3)
     v[i] = -0.5;
@@ -401,12 +408,13 @@ TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
 }
 
 TEST(ContactScenes, StartingInsideAnObstacleIsAnError) {
-  SimulationOptions options;
-  options.obstacles = {plane_obstacle("obstacles.0", Vector3d(0, 0, 0.05), Vector3d::UnitZ())};
   SolverSettings settings;
   try {
-    Simulation sim(cube(), rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings,
-                   std::move(options));
+    Simulation sim(
+        cube(),
+        {.material = rubber(),
+         .obstacles = {plane_obstacle("obstacles.0", Vector3d(0, 0, 0.05), Vector3d::UnitZ())}},
+        settings);
     FAIL() << "no error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("obstacles.0: contact point"), std::string::npos)

@@ -232,8 +232,11 @@ TEST(SimulationEmbedding, StaticEquilibriumOfTheConstrainedSystem) {
   SimulationOptions options;
   options.vertex_embedding = box.C;
   options.dof_vertices = box.dof_vertices;
-  Simulation sim(box.mesh, test_material(MaterialModel::neohookean), {clamp_at_x0()}, {},
-                 std::nullopt, Vector3d(0, 0, -50.0), static_settings(), options);
+  Simulation sim(box.mesh,
+                 {.material = test_material(MaterialModel::neohookean),
+                  .dirichlet = {clamp_at_x0()},
+                  .gravity = Vector3d(0, 0, -50.0)},
+                 static_settings(), options);
   // Total mass is kept by Cᵀ m.
   EXPECT_NEAR(sim.dof_vertex_mass().sum(), sim.vertex_mass().sum(), 1e-9);
   EXPECT_NEAR(sim.vertex_mass().sum(), 1000.0 * 2.0, 1e-9);
@@ -280,14 +283,12 @@ TEST(SimulationEmbedding, RestartingFromAStepContinuesTheTrajectory) {
   options.vertex_embedding = box.C;
   options.dof_vertices = box.dof_vertices;
   const Material material = test_material(MaterialModel::stvk);
-  Simulation reference(box.mesh, material, groups, {}, std::nullopt, Vector3d::Zero(), settings,
-                       options);
+  Simulation reference(box.mesh, {.material = material, .dirichlet = groups}, settings, options);
   for (int i = 0; i < 8; ++i)
     reference.advance();
   SimulationOptions restart = options;
   restart.first_step = 8;
-  Simulation resumed(box.mesh, material, groups, {}, std::nullopt, Vector3d::Zero(), settings,
-                     restart);
+  Simulation resumed(box.mesh, {.material = material, .dirichlet = groups}, settings, restart);
   EXPECT_DOUBLE_EQ(resumed.time(), reference.time());
   resumed.set_state(reference.dof_positions(), reference.dof_velocities());
   while (!reference.finished()) {

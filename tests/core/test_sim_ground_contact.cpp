@@ -90,7 +90,9 @@ TEST(SimGroundContact, DroppedCubeStaysAboveTheGround) {
   settings.duration = 0.4;
   GroundPlane ground;
   ground.friction = 0.3;
-  Simulation sim(mesh, soft_material(), {}, {}, ground, Vector3d(0, 0, -9.81), settings);
+  Simulation sim(mesh,
+                 {.material = soft_material(), .gravity = Vector3d(0, 0, -9.81), .ground = ground},
+                 settings);
   double min_z_seen = 1.0;
   while (!sim.finished()) {
     sim.advance();
@@ -116,7 +118,9 @@ double slide(double friction, double duration) {
   settings.duration = duration;
   GroundPlane ground;
   ground.friction = friction;
-  Simulation sim(mesh, soft_material(), {}, {}, ground, Vector3d(0, 0, -9.81), settings);
+  Simulation sim(mesh,
+                 {.material = soft_material(), .gravity = Vector3d(0, 0, -9.81), .ground = ground},
+                 settings);
   VectorXd v = VectorXd::Zero(sim.velocities().size());
   for (Index i = 0; i < v.size() / 3; ++i)
     v[3 * i] = 1.0;

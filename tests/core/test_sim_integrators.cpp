@@ -41,12 +41,10 @@ struct FreeBeam {
     // Probe the estimate with a throw-away instance (it depends on mesh and material only).
     settings.dt = 1.0;
     const double estimate =
-        Simulation(mesh, beam_material(model), {}, {}, std::nullopt, Vector3d::Zero(), settings)
-            .stable_dt_estimate();
+        Simulation(mesh, {.material = beam_material(model)}, settings).stable_dt_estimate();
     settings.dt = dt_over_estimate * estimate;
-    sim = std::make_unique<Simulation>(mesh, beam_material(model), std::vector<DirichletSpec>{},
-                                       std::vector<RegionLoad>{}, std::nullopt, Vector3d::Zero(),
-                                       settings);
+    sim =
+        std::make_unique<Simulation>(mesh, ProblemSpec{.material = beam_material(model)}, settings);
     VectorXd x = sim->positions();
     const double strain = 0.01, nu = beam_material(model).poisson_ratio;
     for (Index v = 0; v < x.size() / 3; ++v) {
@@ -109,11 +107,14 @@ TEST(SimIntegrators, ForcesPreparedAfterAStepGiveTheSameTrajectory) {
   settings.duration = 1.0;
   settings.dt = 1e-6;
   {
-    const Simulation probe(mesh, material, {}, {}, ground, Vector3d(0, 0, -9.81), settings);
+    const Simulation probe(
+        mesh, {.material = material, .gravity = Vector3d(0, 0, -9.81), .ground = ground}, settings);
     settings.dt = 0.5 * probe.stable_dt_estimate();
   }
-  Simulation prepared(mesh, material, {}, {}, ground, Vector3d(0, 0, -9.81), settings);
-  Simulation fresh(mesh, material, {}, {}, ground, Vector3d(0, 0, -9.81), settings);
+  Simulation prepared(
+      mesh, {.material = material, .gravity = Vector3d(0, 0, -9.81), .ground = ground}, settings);
+  Simulation fresh(mesh, {.material = material, .gravity = Vector3d(0, 0, -9.81), .ground = ground},
+                   settings);
   bool touched = false;
   for (int step = 0; step < 4000 && !touched; ++step) {
     prepared.advance();

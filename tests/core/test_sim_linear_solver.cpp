@@ -35,7 +35,9 @@ ColumnRun solve_column(SimulationMode mode, LinearSolverKind solver,
   settings.dt = 0.01;
   settings.duration = 0.1;
   settings.load_steps = 2;
-  Simulation sim(mesh, material, {base}, {}, std::nullopt, Vector3d(5, 0, -9.81), settings);
+  Simulation sim(mesh,
+                 {.material = material, .dirichlet = {base}, .gravity = Vector3d(5, 0, -9.81)},
+                 settings);
   while (!sim.finished())
     sim.advance();
   EXPECT_GT(sim.counters().newton_iterations, 0);

@@ -20,7 +20,7 @@ std::string construction_error(const TetMesh& mesh) {
   SolverSettings settings;
   settings.mode = SimulationMode::dynamic;
   try {
-    const Simulation sim(mesh, material, {}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings);
+    const Simulation sim(mesh, {.material = material, .gravity = Vector3d(0, 0, -9.81)}, settings);
   } catch (const InputError& e) {
     return e.what();
   }

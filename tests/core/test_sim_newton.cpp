@@ -241,7 +241,9 @@ TEST(Newton, SimulationCountsHessianKindsAndCriteria) {
   DirichletSpec clamp;
   clamp.name = "fixed[0]";
   clamp.region = PlaneRegion{Vector3d::Zero(), Vector3d::UnitX(), 0.0};
-  Simulation sim(c.mesh, c.material, {clamp}, {}, std::nullopt, Vector3d(0, 0, -9.81), settings);
+  Simulation sim(c.mesh,
+                 {.material = c.material, .dirichlet = {clamp}, .gravity = Vector3d(0, 0, -9.81)},
+                 settings);
   while (!sim.finished())
     sim.advance();
   const SimulationCounters counters = sim.counters();

@@ -131,7 +131,7 @@ std::pair<double, double> spring_cantilever(double yield_strain) {
   settings.load_steps = 12;
   SimulationOptions options;
   options.surface_springs = SurfaceSpringSettings{5e7, yield_strain, 0.5, 2};
-  Simulation sim(mesh, material, {clamp}, {tip}, std::nullopt, Vector3d::Zero(), settings,
+  Simulation sim(mesh, {.material = material, .dirichlet = {clamp}, .loads = {tip}}, settings,
                  std::move(options));
   double peak = 0.0;
   const auto tip_z = [&]() {

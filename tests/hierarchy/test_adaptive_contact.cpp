@@ -57,12 +57,13 @@ TEST(AdaptiveContact, FullModeEqualsCoreOnTheLeavesWithTheSameBarrier) {
   settings.dt = 2e-3;
   settings.duration = 0.16;
   const Vector3d gravity(0, 0, -9.81);
-  AdaptiveSimulation full(coarse, hierarchy(1, HierarchyMode::full), rubber(), {}, {}, std::nullopt,
-                          gravity, settings, obstacles);
+  AdaptiveSimulation full(coarse, hierarchy(1, HierarchyMode::full),
+                          {.material = rubber(), .gravity = gravity, .obstacles = obstacles},
+                          settings);
   SimulationOptions options;
-  options.obstacles = obstacles;
   options.contact_stiffness = full.contact_stiffness();
-  Simulation leaves(full.flat().mesh, rubber(), {}, {}, std::nullopt, gravity, settings,
+  Simulation leaves(full.flat().mesh,
+                    {.material = rubber(), .gravity = gravity, .obstacles = obstacles}, settings,
                     std::move(options));
   while (!leaves.finished()) {
     full.advance();
@@ -82,8 +83,11 @@ TEST(AdaptiveContact, BlockDroppedOnASphereStaysWithinTheToleranceOnAnAdaptiveCu
   SolverSettings settings;
   settings.dt = 2e-3;
   settings.duration = 0.3;
-  AdaptiveSimulation sim(coarse, error_controlled(1, 0.01), rubber(), {}, {}, std::nullopt,
-                         Vector3d(0, 0, -9.81), settings, {sphere_obstacle(Vector3d::Zero(), 0.2)});
+  AdaptiveSimulation sim(coarse, error_controlled(1, 0.01),
+                         {.material = rubber(),
+                          .gravity = Vector3d(0, 0, -9.81),
+                          .obstacles = {sphere_obstacle(Vector3d::Zero(), 0.2)}},
+                         settings);
   double lowest = 1.0;
   while (!sim.finished()) {
     sim.advance();
@@ -119,8 +123,12 @@ TEST(AdaptiveContact, AFailedCutChangeLeavesThePreviousCutAtTheStartOfTheStep) {
   solver.duration = 0.02;
   const std::vector<DirichletSpec> clamp = {
       testing::fixed_plane("top", Vector3d(0, 0, 0.32), Vector3d::UnitZ())};
-  AdaptiveSimulation sim(coarse, settings, rubber(), clamp, {}, std::nullopt, Vector3d(0, 0, -9.81),
-                         solver, {sphere_obstacle(Vector3d::Zero(), 0.223)});
+  AdaptiveSimulation sim(coarse, settings,
+                         {.material = rubber(),
+                          .dirichlet = clamp,
+                          .gravity = Vector3d(0, 0, -9.81),
+                          .obstacles = {sphere_obstacle(Vector3d::Zero(), 0.223)}},
+                         solver);
   const Index root_tets = sim.cut().size();
   const VectorXd start = sim.simulation().positions();
   try {
@@ -156,8 +164,11 @@ TEST(AdaptiveContact, ASphereBetweenTheCoarseVerticesIsFeltOnACoarseCut) {
   const auto depth_of_centre = [&](bool finest) {
     HierarchySettings h = hierarchy(2, HierarchyMode::uniform, 0);
     h.finest_contact_points = finest;
-    AdaptiveSimulation sim(coarse, h, material, {}, {}, std::nullopt, Vector3d(0, 0, -9.81),
-                           settings, {sphere_obstacle(Vector3d::Zero(), 0.2)});
+    AdaptiveSimulation sim(coarse, h,
+                           {.material = material,
+                            .gravity = Vector3d(0, 0, -9.81),
+                            .obstacles = {sphere_obstacle(Vector3d::Zero(), 0.2)}},
+                           settings);
     TetLocator locator(coarse.vertices, coarse.tets);
     const std::optional<TetLocation> root = locator.locate(centre.position, 1e-9);
     EXPECT_TRUE(root.has_value());
@@ -198,9 +209,12 @@ TEST(AdaptiveContact, FineContactPointsCarryABlockOnACoarseCut) {
   Material material = rubber();
   material.mass_damping = 20.0;
   const Vector3d gravity(0, 0, -9.81);
-  AdaptiveSimulation sim(coarse, hierarchy(2, HierarchyMode::uniform, 0), material, {}, {},
-                         std::nullopt, gravity, settings,
-                         {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}, surface);
+  AdaptiveSimulation sim(
+      coarse, hierarchy(2, HierarchyMode::uniform, 0),
+      {.material = material,
+       .gravity = gravity,
+       .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+      settings, surface);
   while (!sim.finished())
     sim.advance();
   const Simulation& current = sim.simulation();
@@ -239,9 +253,12 @@ TEST(AdaptiveContact, ASlidingSphereIsRefinedUnderAndReleasedBehind) {
   HierarchySettings h = error_controlled(1, 0.01);
   h.criteria.min_steps_between_changes = 5;
   h.adapt_every = 5;
-  AdaptiveSimulation sim(coarse, h, material,
-                         {testing::fixed_plane("fixed", Vector3d::Zero(), Vector3d::UnitZ())}, {},
-                         std::nullopt, Vector3d::Zero(), settings, {sphere});
+  AdaptiveSimulation sim(
+      coarse, h,
+      {.material = material,
+       .dirichlet = {testing::fixed_plane("fixed", Vector3d::Zero(), Vector3d::UnitZ())},
+       .obstacles = {sphere}},
+      settings);
   // Mean level of the active tets with centroid x in [lo, hi].
   const auto mean_level = [&](double lo, double hi) {
     const VectorXi levels = sim.cell_levels();
@@ -286,15 +303,16 @@ struct SunkBlock {
   TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.1, 0.1, 0.1), {1, 1, 1});
 
   std::unique_ptr<Simulation> sink(double depth, SimulationOptions options = {}) const {
-    options.obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())};
     options.first_step = 1;  // a continued run: its state comes from set_state
     SolverSettings settings;
     settings.dt = 1e-3;
     settings.duration = 1.0;
     settings.contact_distance = 1e-3;
-    auto sim = std::make_unique<Simulation>(mesh, rubber(), std::vector<DirichletSpec>{},
-                                            std::vector<RegionLoad>{}, std::nullopt,
-                                            Vector3d::Zero(), settings, std::move(options));
+    auto sim = std::make_unique<Simulation>(
+        mesh,
+        ProblemSpec{.material = rubber(),
+                    .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+        settings, std::move(options));
     VectorXd x = flatten(mesh.vertices);
     for (Index v = 0; v < mesh.vertices.rows(); ++v)
       if (x[3 * v + 2] == 0.0) x[3 * v + 2] = -depth;

@@ -65,16 +65,20 @@ VectorXd in_reference_order(const AdaptiveSimulation& adaptive, const TetMesh& r
 
 TEST(AdaptiveSimulation, FullModeEqualsCoreOnTheLeafMesh) {
   const Bar bar;
-  AdaptiveSimulation adaptive(bar.coarse, hierarchy(1, HierarchyMode::full), rubber(), bar.fixed,
-                              bar.loads, std::nullopt, bar.gravity, static_settings(2));
+  AdaptiveSimulation adaptive(
+      bar.coarse, hierarchy(1, HierarchyMode::full),
+      {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads, .gravity = bar.gravity},
+      static_settings(2));
   run(adaptive);
   // Independent path: core's Simulation on the flattened leaves, loads spread by core itself.
   TetTree tree(bar.coarse, 1);
   for (NodeId r = 0; r < tree.num_roots(); ++r)
     tree.refine(r);
   const FlatTreeMesh leaves = flatten_leaves(tree);
-  Simulation reference(leaves.mesh, rubber(), bar.fixed, bar.loads, std::nullopt, bar.gravity,
-                       static_settings(2));
+  Simulation reference(
+      leaves.mesh,
+      {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads, .gravity = bar.gravity},
+      static_settings(2));
   run(reference);
   ASSERT_EQ(adaptive.flat().mesh.tets.rows(), leaves.mesh.tets.rows());
   ASSERT_EQ(adaptive.constraints().num_hanging(), 0);
@@ -92,11 +96,15 @@ TEST(AdaptiveSimulation, UniformCoarseLevelEqualsCoreOnTheCoarseMesh) {
   // spreading on the coarse mesh for a load on whole coarse faces (a uniform traction's lumped
   // loads are consistent, and consistent loads nest).
   const Bar bar;
-  AdaptiveSimulation adaptive(bar.coarse, hierarchy(2, HierarchyMode::uniform, 0), rubber(),
-                              bar.fixed, bar.loads, std::nullopt, bar.gravity, static_settings(2));
+  AdaptiveSimulation adaptive(
+      bar.coarse, hierarchy(2, HierarchyMode::uniform, 0),
+      {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads, .gravity = bar.gravity},
+      static_settings(2));
   run(adaptive);
-  Simulation reference(bar.coarse, rubber(), bar.fixed, bar.loads, std::nullopt, bar.gravity,
-                       static_settings(2));
+  Simulation reference(
+      bar.coarse,
+      {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads, .gravity = bar.gravity},
+      static_settings(2));
   run(reference);
   ASSERT_EQ(adaptive.flat().mesh.tets.rows(), bar.coarse.tets.rows());
   const double scale = (reference.positions() - reference.model().rest_positions()).norm();
@@ -183,8 +191,8 @@ TEST(AdaptiveSimulation, SmallFixedPatchIsResolvedExactly) {
   push.kind = DirichletKind::displacement;
   push.displacement = Vector3d(0, 0, -0.01);
   groups.push_back(push);
-  AdaptiveSimulation sim(coarse, hierarchy(3, HierarchyMode::uniform, 0), rubber(), groups, {},
-                         std::nullopt, Vector3d::Zero(), static_settings(1));
+  AdaptiveSimulation sim(coarse, hierarchy(3, HierarchyMode::uniform, 0),
+                         {.material = rubber(), .dirichlet = groups}, static_settings(1));
   EXPECT_GT(sim.cut().size(), coarse.tets.rows());            // refined for exactness
   EXPECT_LT(sim.cut().size(), 512 * coarse.tets.rows() / 4);  // … only near the patch
   run(sim);
@@ -216,7 +224,8 @@ struct PressedSlab {
   MatrixX3d probe = (MatrixX3d(1, 3) << 0.5, 0.5, 0.25).finished();
 
   double probe_uz(const HierarchySettings& settings, Index* tets) const {
-    AdaptiveSimulation sim(coarse, settings, rubber(), fixed, loads, std::nullopt, Vector3d::Zero(),
+    AdaptiveSimulation sim(coarse, settings,
+                           {.material = rubber(), .dirichlet = fixed, .loads = loads},
                            static_settings(2));
     run(sim);
     if (tets) *tets = sim.cut().size();
@@ -261,8 +270,9 @@ ChangingSlabRun changing_slab_run(int start_level,
 TEST(AdaptiveSimulation, RefinementKeepsTheEnergyAndTheCutFollowsTheLoad) {
   const PressedSlab slab;
   const ChangingSlabRun setup = changing_slab_run(0);
-  AdaptiveSimulation sim(slab.coarse, setup.hierarchy, rubber(), slab.fixed, slab.loads,
-                         std::nullopt, Vector3d::Zero(), setup.solver);
+  AdaptiveSimulation sim(slab.coarse, setup.hierarchy,
+                         {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+                         setup.solver);
   run(sim);
   ASSERT_FALSE(sim.changes().empty());
   for (const CutChangeRecord& change : sim.changes()) {
@@ -322,8 +332,9 @@ TEST(AdaptiveSimulation, ACutChangeRecordsTheMultigridSetupsOfItsCut) {
     // From level 1: the cuts have a coarse level of an eighth of their vertices (a space that
     // shrinks less is merged into the next, and a single level is solved by CHOLMOD).
     const ChangingSlabRun setup = changing_slab_run(1, solver);
-    AdaptiveSimulation sim(slab.coarse, setup.hierarchy, rubber(), slab.fixed, slab.loads,
-                           std::nullopt, Vector3d::Zero(), setup.solver);
+    AdaptiveSimulation sim(slab.coarse, setup.hierarchy,
+                           {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+                           setup.solver);
     run(sim);
     ASSERT_GE(sim.changes().size(), 2u);
     long recorded = 0, carried = 0;
@@ -370,8 +381,9 @@ TEST(AdaptiveSimulation, ACutChangeSeedsTheNewCutsSmoothersWithThoseOfTheCutBefo
   // (MultigridPreconditioner::seed_smoother_estimates).
   const PressedSlab slab;
   const ChangingSlabRun setup = changing_slab_run(1, LinearSolverKind::multigrid);
-  AdaptiveSimulation sim(slab.coarse, setup.hierarchy, rubber(), slab.fixed, slab.loads,
-                         std::nullopt, Vector3d::Zero(), setup.solver);
+  AdaptiveSimulation sim(slab.coarse, setup.hierarchy,
+                         {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+                         setup.solver);
   std::vector<SmootherEstimate> left;  // of the cut a change left, until the new cut's first setup
   int compared_levels = 0;
   while (!sim.finished()) {
@@ -417,23 +429,24 @@ TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
   settings.dt = 1.0;
   settings.duration = 1.0;
   const double coarse_dt =
-      Simulation(slab.coarse, rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings)
-          .stable_dt_estimate();
+      Simulation(slab.coarse, {.material = rubber()}, settings).stable_dt_estimate();
   settings.dt = 0.9 * coarse_dt;
   settings.duration = 20 * settings.dt;
   HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
   h.adapt_every = 1;
   h.criteria.min_steps_between_changes = 0;
-  AdaptiveSimulation sim(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
-                         Vector3d::Zero(), settings);
+  AdaptiveSimulation sim(slab.coarse, h,
+                         {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+                         settings);
   run(sim);
   EXPECT_EQ(sim.cut().finest_level(), 0);
   // The error-controlled defaults: over the tolerance on a cut no tet of which may refine, the
   // controller is not asked at all; each such decision is counted.
   HierarchySettings defaults;
   defaults.levels = 2;
-  AdaptiveSimulation controlled(slab.coarse, defaults, rubber(), slab.fixed, slab.loads,
-                                std::nullopt, Vector3d::Zero(), settings);
+  AdaptiveSimulation controlled(
+      slab.coarse, defaults, {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+      settings);
   run(controlled);
   EXPECT_EQ(controlled.cut().finest_level(), 0);
   const ToleranceReport& report = controlled.tolerance_report();
@@ -444,8 +457,9 @@ TEST(AdaptiveSimulation, ExplicitIntegratorNeverRefinesBelowItsStableStep) {
   // With a small enough step the same scene refines.
   settings.dt = 0.2 * coarse_dt;
   settings.duration = 20 * settings.dt;
-  AdaptiveSimulation fine(slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt,
-                          Vector3d::Zero(), settings);
+  AdaptiveSimulation fine(slab.coarse, h,
+                          {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+                          settings);
   run(fine);
   EXPECT_GT(fine.cut().finest_level(), 0);
 }
@@ -458,10 +472,12 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevel
   settings.dt = 1.0;
   settings.duration = 1.0;
   HierarchySettings full = hierarchy(2, HierarchyMode::full);
-  const double finest_dt = AdaptiveSimulation(slab.coarse, full, rubber(), slab.fixed, slab.loads,
-                                              std::nullopt, Vector3d::Zero(), settings)
-                               .simulation()
-                               .stable_dt_estimate();
+  const double finest_dt =
+      AdaptiveSimulation(slab.coarse, full,
+                         {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
+                         settings)
+          .simulation()
+          .stable_dt_estimate();
   HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
   h.adapt_every = 1;
   h.criteria.min_steps_between_changes = 0;
@@ -470,7 +486,8 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevel
     settings.dt = dt;
     settings.duration = 20 * dt;
     auto sim = std::make_unique<AdaptiveSimulation>(
-        slab.coarse, h, rubber(), slab.fixed, slab.loads, std::nullopt, Vector3d::Zero(), settings);
+        slab.coarse, h,
+        ProblemSpec{.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads}, settings);
     run(*sim);
     return sim;
   };
@@ -490,8 +507,12 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevel
 TEST(AdaptiveSimulation, RejectsBadSettings) {
   const Bar bar;
   HierarchySettings h = hierarchy(2, HierarchyMode::uniform, 3);
-  EXPECT_THROW(AdaptiveSimulation(bar.coarse, h, rubber(), bar.fixed, bar.loads, std::nullopt,
-                                  bar.gravity, static_settings(1)),
+  EXPECT_THROW(AdaptiveSimulation(bar.coarse, h,
+                                  {.material = rubber(),
+                                   .dirichlet = bar.fixed,
+                                   .loads = bar.loads,
+                                   .gravity = bar.gravity},
+                                  static_settings(1)),
                InputError);
   h = hierarchy(9, HierarchyMode::full);
   EXPECT_THROW(validate_hierarchy_settings(h, "hierarchy"), InputError);

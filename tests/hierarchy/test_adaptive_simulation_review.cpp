@@ -43,11 +43,15 @@ CoarseningRun coarsen_after_five_steps(const std::vector<DirichletSpec>& fixed,
   h.criteria.coarsen_indicator_fraction = 1.0;
   h.criteria.coarsen_tolerance = 1e6;
   h.criteria.min_steps_between_changes = 0;
-  AdaptiveSimulation adaptive(coarse, h, testing::rubber(), fixed, loads, std::nullopt, gravity,
-                              settings);
+  AdaptiveSimulation adaptive(
+      coarse, h,
+      {.material = testing::rubber(), .dirichlet = fixed, .loads = loads, .gravity = gravity},
+      settings);
   // Independent reference for the state just before the change: the same level-1 mesh.
-  Simulation reference(adaptive.flat().mesh, testing::rubber(), fixed, loads, std::nullopt, gravity,
-                       settings);
+  Simulation reference(
+      adaptive.flat().mesh,
+      {.material = testing::rubber(), .dirichlet = fixed, .loads = loads, .gravity = gravity},
+      settings);
   for (int k = 0; k < 5; ++k) {
     adaptive.advance();
     reference.advance();
@@ -96,7 +100,7 @@ TEST(AdaptiveSimulationReview, StaticRefinementRecordKeepsEnergyWithPrescribedDi
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 2;
   AdaptiveSimulation sim(coarse, testing::hierarchy(2, HierarchyMode::adaptive, 0),
-                         testing::rubber(), {lift}, {load}, std::nullopt, Vector3d::Zero(),
+                         {.material = testing::rubber(), .dirichlet = {lift}, .loads = {load}},
                          settings);
   while (!sim.finished())
     sim.advance();
@@ -136,8 +140,8 @@ TEST(AdaptiveSimulationReview, OverlappingGroupsStayExactOnTheCut) {
   for (size_t k = 0; k < points.size(); ++k)
     probes.row(static_cast<Index>(k)) = points[k].transpose();
   for (const HierarchyMode mode : {HierarchyMode::full, HierarchyMode::uniform}) {
-    AdaptiveSimulation sim(coarse, testing::hierarchy(3, mode, 0), testing::rubber(), groups, {},
-                           std::nullopt, Vector3d::Zero(), settings);
+    AdaptiveSimulation sim(coarse, testing::hierarchy(3, mode, 0),
+                           {.material = testing::rubber(), .dirichlet = groups}, settings);
     while (!sim.finished())
       sim.advance();
     const MatrixX3d u = sim.displacements(sim.locate(probes, "probes", 1e-9));
@@ -168,20 +172,18 @@ TEST(AdaptiveSimulationReview, ExplicitRunNeverStartsBelowItsStableStep) {
   settings.dt = 1.0;
   settings.duration = 1.0;
   const double coarse_dt =
-      Simulation(coarse, testing::rubber(), {}, {}, std::nullopt, Vector3d::Zero(), settings)
-          .stable_dt_estimate();
+      Simulation(coarse, {.material = testing::rubber()}, settings).stable_dt_estimate();
   settings.dt = 0.9 * coarse_dt;
   settings.duration = 400 * settings.dt;
-  EXPECT_THROW(
-      AdaptiveSimulation(coarse, testing::hierarchy(3, HierarchyMode::adaptive, 0),
-                         testing::rubber(), groups, {}, std::nullopt, Vector3d::Zero(), settings),
-      InputError);
+  EXPECT_THROW(AdaptiveSimulation(coarse, testing::hierarchy(3, HierarchyMode::adaptive, 0),
+                                  {.material = testing::rubber(), .dirichlet = groups}, settings),
+               InputError);
   // Small enough a step: the run starts on the refined cut, above its stable step, and stays
   // finite.
   settings.dt = 0.1 * coarse_dt;
   settings.duration = 50 * settings.dt;
   AdaptiveSimulation sim(coarse, testing::hierarchy(3, HierarchyMode::adaptive, 0),
-                         testing::rubber(), groups, {}, std::nullopt, Vector3d::Zero(), settings);
+                         {.material = testing::rubber(), .dirichlet = groups}, settings);
   EXPECT_GT(sim.cut().finest_level(), 0);
   EXPECT_GE(sim.simulation().stable_dt_estimate(), settings.dt);
   EXPECT_NO_THROW(while (!sim.finished()) sim.advance());

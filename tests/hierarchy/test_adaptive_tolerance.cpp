@@ -66,7 +66,7 @@ struct PokedPlate {
   std::vector<MatrixX3d> run(const HierarchySettings& h, ToleranceReport* report = nullptr,
                              Index* initial_tets = nullptr, long* steps = nullptr,
                              Index* final_tets = nullptr) const {
-    AdaptiveSimulation sim(coarse, h, material(), fixed, loads, std::nullopt, Vector3d::Zero(),
+    AdaptiveSimulation sim(coarse, h, {.material = material(), .dirichlet = fixed, .loads = loads},
                            solver());
     if (initial_tets) *initial_tets = sim.cut().size();
     std::vector<MatrixX3d> frames = run(sim);
@@ -189,7 +189,8 @@ TEST(AdaptiveTolerance, InStepRefinementAimsBelowTheToleranceSoACreepingEstimate
   const MatrixX3d probes =
       (MatrixX3d(3, 3) << 0.2, 0.1, 0.1, 0.2, 0.2, 0.0, 0.1, 0.1, 0.05).finished();
   const auto run = [&](const HierarchySettings& h, ToleranceReport* report) {
-    AdaptiveSimulation sim(coarse, h, gel, fixed, {}, std::nullopt, Vector3d(0, 0, -9.81), solver);
+    AdaptiveSimulation sim(
+        coarse, h, {.material = gel, .dirichlet = fixed, .gravity = Vector3d(0, 0, -9.81)}, solver);
     const std::vector<RootPoint> points = sim.locate(probes, "probes", 1e-9);
     std::vector<MatrixX3d> frames;
     while (!sim.finished()) {
@@ -333,8 +334,12 @@ StaticBlockResult static_block(HierarchyMode mode, int level, bool gravity = fal
   HierarchySettings h = defaults(2);
   h.mode = mode;
   h.level = level;
-  AdaptiveSimulation sim(coarse, h, rubber(), fixed, gravity ? std::vector<RegionLoad>{} : loads,
-                         std::nullopt, gravity ? Vector3d(0, 0, -9.81) : Vector3d::Zero(), solver);
+  AdaptiveSimulation sim(coarse, h,
+                         {.material = rubber(),
+                          .dirichlet = fixed,
+                          .loads = gravity ? std::vector<RegionLoad>{} : loads,
+                          .gravity = gravity ? Vector3d(0, 0, -9.81) : Vector3d::Zero()},
+                         solver);
   while (!sim.finished())
     sim.advance();
   return {sim.current().elastic_energy(), sim.history().back()};
@@ -388,9 +393,12 @@ TEST(AdaptiveTolerance, CoarseningKeepsTheEstimateWithinTheTolerance) {
   solver.duration = 1.0;
   HierarchySettings h = defaults(2);
   h.tolerance = 0.02;
-  AdaptiveSimulation sim(coarse, h, material,
-                         {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX())}, {},
-                         std::nullopt, Vector3d(0, 0, -9.81), solver);
+  AdaptiveSimulation sim(
+      coarse, h,
+      {.material = material,
+       .dirichlet = {fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitX())},
+       .gravity = Vector3d(0, 0, -9.81)},
+      solver);
   while (!sim.finished())
     sim.advance();
   Index coarsened = 0;
@@ -427,9 +435,12 @@ struct TwoPatchSlab {
     right.name = "forces.1";
     right.amplitude.points = right_amplitude;
     return std::make_unique<AdaptiveSimulation>(
-        coarse, hierarchy, material,
-        std::vector<DirichletSpec>{fixed_plane("fixed.0", Vector3d::Zero(), Vector3d::UnitZ())},
-        std::vector<RegionLoad>{left, right}, std::nullopt, Vector3d::Zero(), solver);
+        coarse, hierarchy,
+        ProblemSpec{.material = material,
+                    .dirichlet = std::vector<DirichletSpec>{fixed_plane("fixed.0", Vector3d::Zero(),
+                                                                        Vector3d::UnitZ())},
+                    .loads = std::vector<RegionLoad>{left, right}},
+        solver);
   }
 };
 

@@ -651,8 +651,10 @@ TEST(CutMultigrid, RunsMatchCholmod) {
       SCOPED_TRACE(std::string(dynamic ? "dynamic " : "static ") + to_string(mode));
       auto run = [&](LinearSolverKind kind) {
         solver.linear_solver = kind;
-        AdaptiveSimulation sim(coarse, hierarchy, rubber, {clamp}, {}, std::nullopt,
-                               Vector3d(0.0, 0.0, -9.81), solver);
+        AdaptiveSimulation sim(
+            coarse, hierarchy,
+            {.material = rubber, .dirichlet = {clamp}, .gravity = Vector3d(0.0, 0.0, -9.81)},
+            solver);
         while (!sim.finished())
           sim.advance();
         EXPECT_EQ(sim.counters().linear_solver, kind);

@@ -122,9 +122,9 @@ struct BarRun {
     SimulationOptions options;
     options.first_step = first_step;
     options.plastic_state = std::move(state);
-    return std::make_unique<Simulation>(flat.mesh, material, groups, std::vector<RegionLoad>{},
-                                        std::nullopt, Vector3d::Zero(), settings,
-                                        std::move(options));
+    return std::make_unique<Simulation>(flat.mesh,
+                                        ProblemSpec{.material = material, .dirichlet = groups},
+                                        settings, std::move(options));
   }
 };
 

@@ -304,10 +304,11 @@ TEST(PrecomputedPlayback, AUniformCutMatchesTheUniformMode) {
   const Bar bar;
   HierarchySettings precomputed = hierarchy(2, HierarchyMode::precomputed);
   precomputed.precomputed = uniform_cut(bar.coarse, 2, 1);
-  AdaptiveSimulation played(bar.coarse, precomputed, rubber(), bar.fixed, bar.loads, std::nullopt,
-                            Vector3d::Zero(), implicit_settings(0.05));
-  AdaptiveSimulation uniform(bar.coarse, hierarchy(2, HierarchyMode::uniform, 1), rubber(),
-                             bar.fixed, bar.loads, std::nullopt, Vector3d::Zero(),
+  AdaptiveSimulation played(bar.coarse, precomputed,
+                            {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads},
+                            implicit_settings(0.05));
+  AdaptiveSimulation uniform(bar.coarse, hierarchy(2, HierarchyMode::uniform, 1),
+                             {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads},
                              implicit_settings(0.05));
   while (!uniform.finished()) {
     played.advance();
@@ -336,8 +337,9 @@ TEST(PrecomputedPlayback, ASchedulesSwitchesAtItsWindowsAndKeepsTheEnergy) {
   ASSERT_TRUE(schedule->windows[0].refined.empty());
   HierarchySettings settings = hierarchy(2, HierarchyMode::precomputed);
   settings.precomputed = schedule;
-  AdaptiveSimulation run(bar.coarse, settings, rubber(), bar.fixed, bar.loads, std::nullopt,
-                         Vector3d::Zero(), implicit_settings(0.05));
+  AdaptiveSimulation run(bar.coarse, settings,
+                         {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads},
+                         implicit_settings(0.05));
   while (!run.finished())
     run.advance();
   ASSERT_EQ(run.changes().size(), 1u);
@@ -354,13 +356,17 @@ TEST(PrecomputedPlayback, RejectsACutOfAnotherMesh) {
   const Bar bar;
   HierarchySettings settings = hierarchy(2, HierarchyMode::precomputed);
   settings.precomputed = uniform_cut(test_box(), 2, 1);
-  EXPECT_THROW(AdaptiveSimulation(bar.coarse, settings, rubber(), bar.fixed, bar.loads,
-                                  std::nullopt, Vector3d::Zero(), implicit_settings(0.05)),
-               InputError);
+  EXPECT_THROW(
+      AdaptiveSimulation(bar.coarse, settings,
+                         {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads},
+                         implicit_settings(0.05)),
+      InputError);
   settings.precomputed = nullptr;
-  EXPECT_THROW(AdaptiveSimulation(bar.coarse, settings, rubber(), bar.fixed, bar.loads,
-                                  std::nullopt, Vector3d::Zero(), implicit_settings(0.05)),
-               InputError);
+  EXPECT_THROW(
+      AdaptiveSimulation(bar.coarse, settings,
+                         {.material = rubber(), .dirichlet = bar.fixed, .loads = bar.loads},
+                         implicit_settings(0.05)),
+      InputError);
 }
 
 }  // namespace

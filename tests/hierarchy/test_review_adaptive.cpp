@@ -51,8 +51,9 @@ TEST(ReviewAdaptiveSimulation, StaticAdaptiveRunEqualsADirectSolveOnItsFinalCut)
   SolverSettings settings;
   settings.mode = SimulationMode::static_equilibrium;
   settings.load_steps = 3;
-  AdaptiveSimulation adaptive(slab.coarse, adaptive_from_coarse(2), testing::rubber(), slab.groups,
-                              slab.loads, std::nullopt, Vector3d::Zero(), settings);
+  AdaptiveSimulation adaptive(
+      slab.coarse, adaptive_from_coarse(2),
+      {.material = testing::rubber(), .dirichlet = slab.groups, .loads = slab.loads}, settings);
   while (!adaptive.finished())
     adaptive.advance();
   ASSERT_FALSE(adaptive.changes().empty());
@@ -67,8 +68,8 @@ TEST(ReviewAdaptiveSimulation, StaticAdaptiveRunEqualsADirectSolveOnItsFinalCut)
   options.vertex_embedding = adaptive.constraints().matrix();
   options.dof_vertices = adaptive.constraints().free_vertices();
   options.extra_mesh_forces = map_point_loads(adaptive.cut(), flat, point_loads);
-  Simulation direct(flat.mesh, testing::rubber(), slab.groups, {}, std::nullopt, Vector3d::Zero(),
-                    settings, options);
+  Simulation direct(flat.mesh, {.material = testing::rubber(), .dirichlet = slab.groups}, settings,
+                    options);
   while (!direct.finished())
     direct.advance();
 

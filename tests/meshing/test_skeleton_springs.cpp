@@ -136,8 +136,8 @@ double cantilever_ratio(double width, const std::array<int, 3>& cells) {
   settings.integrator = Integrator::implicit_euler;
   settings.dt = 0.05;
   settings.duration = 20.0;
-  SpringBodySimulation run(std::move(body), material, {clamp}, {load}, std::nullopt,
-                           Vector3d::Zero(), settings);
+  SpringBodySimulation run(std::move(body),
+                           {.material = material, .dirichlet = {clamp}, .loads = {load}}, settings);
   while (!run.finished())
     run.advance();
   double tip = 0.0;
@@ -164,9 +164,12 @@ TEST(SkeletonSprings, ABeamDroppedOnAPlaneRestsOnItWithinTheTolerance) {
   settings.integrator = Integrator::implicit_euler;
   settings.dt = 0.01;
   settings.duration = 1.0;
-  SpringBodySimulation run(body_of(surface, curve_skeleton(surface, "beam")), material, {}, {},
-                           std::nullopt, Vector3d(0, 0, -9.81), settings,
-                           {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())});
+  SpringBodySimulation run(
+      body_of(surface, curve_skeleton(surface, "beam")),
+      {.material = material,
+       .gravity = Vector3d(0, 0, -9.81),
+       .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+      settings);
   ASSERT_TRUE(run.has_obstacles());
   while (!run.finished())
     run.advance();
@@ -183,9 +186,11 @@ TEST(SkeletonSprings, ABeamDroppedOnAPlaneRestsOnItWithinTheTolerance) {
   EXPECT_LT(run.kinetic_energy(), 1e-6 * run.body().vertex_mass.sum() * 9.81 * 0.02);
   // A body that starts inside an obstacle is an error naming it.
   EXPECT_THROW(
-      SpringBodySimulation(body_of(surface, curve_skeleton(surface, "beam")), material, {}, {},
-                           std::nullopt, Vector3d::Zero(), settings,
-                           {plane_obstacle("floor", Vector3d(0, 0, 0.05), Vector3d::UnitZ())}),
+      SpringBodySimulation(
+          body_of(surface, curve_skeleton(surface, "beam")),
+          {.material = material,
+           .obstacles = {plane_obstacle("floor", Vector3d(0, 0, 0.05), Vector3d::UnitZ())}},
+          settings),
       InputError);
 }
 

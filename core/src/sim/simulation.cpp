@@ -37,12 +37,15 @@ std::string format_number(double value) {
 
 }  // namespace
 
-Simulation::Simulation(TetMesh mesh, const Material& material,
-                       const std::vector<DirichletSpec>& dirichlet,
-                       const std::vector<RegionLoad>& loads,
-                       const std::optional<GroundPlane>& ground, const Vector3d& gravity,
-                       const SolverSettings& settings, SimulationOptions options)
-    : m_mesh(std::move(mesh)), m_material(material), m_settings(settings), m_ground(ground) {
+Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& settings,
+                       SimulationOptions options)
+    : m_mesh(std::move(mesh)),
+      m_material(std::move(problem.material)),
+      m_settings(settings),
+      m_ground(std::move(problem.ground)) {
+  const std::vector<DirichletSpec>& dirichlet = problem.dirichlet;
+  const std::vector<RegionLoad>& loads = problem.loads;
+  const Vector3d& gravity = problem.gravity;
   validate_material(m_material, "material");
   validate_solver_settings(m_settings, "solver");
   if (m_ground) validate_ground(*m_ground, "ground");
@@ -144,8 +147,8 @@ Simulation::Simulation(TetMesh mesh, const Material& material,
         std::make_unique<SurfaceSprings>(m_mesh.vertices, boundary(), *options.surface_springs);
   }
   ContactSettings contact;
-  if (!options.obstacles.empty()) {
-    m_obstacles = std::move(options.obstacles);
+  if (!problem.obstacles.empty()) {
+    m_obstacles = std::move(problem.obstacles);
     for (const Obstacle& obstacle : m_obstacles)
       validate_obstacle(obstacle);
     // Contact points on the mesh: every boundary vertex (unless the options leave them out), then

@@ -216,17 +216,16 @@ SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i>
   return body;
 }
 
-SpringBodySimulation::SpringBodySimulation(SpringBody body, const Material& material,
-                                           const std::vector<DirichletSpec>& dirichlet,
-                                           const std::vector<RegionLoad>& loads,
-                                           const std::optional<GroundPlane>& ground,
-                                           const Vector3d& gravity, const SolverSettings& settings,
-                                           std::vector<Obstacle> obstacles)
+SpringBodySimulation::SpringBodySimulation(SpringBody body, ProblemSpec problem,
+                                           const SolverSettings& settings)
     : m_body(std::move(body)),
-      m_material(material),
+      m_material(std::move(problem.material)),
       m_settings(settings),
-      m_ground(ground),
-      m_obstacles(std::move(obstacles)) {
+      m_ground(std::move(problem.ground)),
+      m_obstacles(std::move(problem.obstacles)) {
+  const std::vector<DirichletSpec>& dirichlet = problem.dirichlet;
+  const std::vector<RegionLoad>& loads = problem.loads;
+  const Vector3d& gravity = problem.gravity;
   validate_material(m_material, "material");
   validate_solver_settings(m_settings, "solver");
   if (m_settings.mode != SimulationMode::dynamic)

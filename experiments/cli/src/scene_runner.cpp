@@ -118,17 +118,20 @@ class SceneSimulation {
         if (!obstacles.empty() && binding != nullptr)
           for (Index i = 0; i < binding->tets.size(); ++i)
             contact_surface.push_back({binding->tets[i], surface_rest->row(i).transpose()});
-        auto adaptive = std::make_unique<AdaptiveSimulation>(
-            mesh, *scene.hierarchy, scene.material, scene.dirichlet_groups(), scene.forces,
-            std::nullopt, scene.gravity, scene.solver, std::move(obstacles),
-            std::move(contact_surface));
+        auto adaptive =
+            std::make_unique<AdaptiveSimulation>(mesh, *scene.hierarchy,
+                                                 ProblemSpec{.material = scene.material,
+                                                             .dirichlet = scene.dirichlet_groups(),
+                                                             .loads = scene.forces,
+                                                             .gravity = scene.gravity,
+                                                             .obstacles = std::move(obstacles)},
+                                                 scene.solver, std::move(contact_surface));
         m_adaptive = adaptive.get();
         m_run = std::move(adaptive);
       } else {
         SimulationOptions options;
         options.surface_springs = scene.surface_springs;
-        options.obstacles = std::move(obstacles);
-        if (!options.obstacles.empty() && binding != nullptr) {
+        if (!obstacles.empty() && binding != nullptr) {
           // The fine surface collides too: its vertices are contact points through their binding.
           for (Index i = 0; i < binding->corners.rows(); ++i)
             options.contact_points.push_back(
@@ -137,8 +140,12 @@ class SceneSimulation {
                  {binding->barycentric(i, 0), binding->barycentric(i, 1),
                   binding->barycentric(i, 2), binding->barycentric(i, 3)}});
         }
-        m_run = std::make_unique<Simulation>(mesh, scene.material, scene.dirichlet_groups(),
-                                             scene.forces, std::nullopt, scene.gravity,
+        m_run = std::make_unique<Simulation>(mesh,
+                                             ProblemSpec{.material = scene.material,
+                                                         .dirichlet = scene.dirichlet_groups(),
+                                                         .loads = scene.forces,
+                                                         .gravity = scene.gravity,
+                                                         .obstacles = std::move(obstacles)},
                                              scene.solver, std::move(options));
       }
     } catch (const InputError& error) {

@@ -97,9 +97,13 @@ RunSummary run_spring_body_scene(const Scene& scene, const RunOptions& options) 
                              skeleton.owner, scene.material, scene.body.rule, "body");
     std::vector<Obstacle> obstacles =
         build_obstacles(scene, mean_triangle_edge_length(shown.vertices, shown.triangles));
-    run = std::make_unique<SpringBodySimulation>(
-        std::move(body), scene.material, scene.dirichlet_groups(), scene.forces, std::nullopt,
-        scene.gravity, scene.solver, std::move(obstacles));
+    run = std::make_unique<SpringBodySimulation>(std::move(body),
+                                                 ProblemSpec{.material = scene.material,
+                                                             .dirichlet = scene.dirichlet_groups(),
+                                                             .loads = scene.forces,
+                                                             .gravity = scene.gravity,
+                                                             .obstacles = std::move(obstacles)},
+                                                 scene.solver);
   } catch (const InputError& error) {
     throw InputError(scene.file.string() + ": " + error.what());
   }

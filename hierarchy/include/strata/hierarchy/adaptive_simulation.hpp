@@ -223,8 +223,8 @@ struct ToleranceReport {
 class AdaptiveSimulation final : public SimulationRun {
  public:
   /// `coarse`: the roots (validated and oriented by the caller, as for Simulation). The region
-  /// loads are applied on the finest level; gravity, Dirichlet groups, ground and solver settings
-  /// as in Simulation. Contact: `obstacles` (SimulationOptions::obstacles) are contacted by every
+  /// loads of `problem` are applied on the finest level; its gravity, Dirichlet groups and ground
+  /// and the solver settings as in Simulation. Contact: `problem.obstacles` are contacted by every
   /// active cut's boundary vertices, hanging ones included, and by the material points
   /// `contact_surface` (e.g. a fine surface's vertices, located in their roots), embedded in each
   /// cut's active tets — so fine detail collides even on a coarse cut. Without a
@@ -236,12 +236,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// obstacles where a contact point on the old field lies deeper than 0.9 d̂ inside one, to
   /// 0.8 d̂ (Simulation::push_out_of_obstacles, CutChangeRecord::contact_correction). Throws
   /// InputError for invalid settings or scene data.
-  AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy,
-                     const Material& material, std::vector<DirichletSpec> dirichlet,
-                     const std::vector<RegionLoad>& loads, std::optional<GroundPlane> ground,
-                     const Vector3d& gravity, const SolverSettings& settings,
-                     std::vector<Obstacle> obstacles = {},
-                     std::vector<RootPoint> contact_surface = {});
+  AdaptiveSimulation(const TetMesh& coarse, const HierarchySettings& hierarchy, ProblemSpec problem,
+                     const SolverSettings& settings, std::vector<RootPoint> contact_surface = {});
   ~AdaptiveSimulation() override;
   AdaptiveSimulation(const AdaptiveSimulation&) = delete;
   AdaptiveSimulation& operator=(const AdaptiveSimulation&) = delete;
@@ -417,7 +413,10 @@ class AdaptiveSimulation final : public SimulationRun {
   std::vector<Index> m_contact_counts;
   /// Active nodes a contact force acts on, and their ancestors (not coarsened into).
   std::unordered_set<NodeId> m_in_contact;
-  /// Obstacles, contact points and barrier stiffness of the current cut into `options`.
+  /// The scene's problem for a Simulation on the current cut, with `dirichlet` as its groups and
+  /// without its region loads (mapped from the finest level into SimulationOptions).
+  ProblemSpec cut_problem(std::vector<DirichletSpec> dirichlet) const;
+  /// Contact points and barrier stiffness of the current cut into `options`.
   void add_contact(SimulationOptions& options) const;
   /// The external loads the criteria see: m_mesh_external plus the contact forces (updating
   /// m_in_contact).

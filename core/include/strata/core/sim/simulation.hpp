@@ -38,6 +38,7 @@
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/multigrid.hpp"
 #include "strata/core/sim/obstacle.hpp"
+#include "strata/core/sim/problem_spec.hpp"
 #include "strata/core/sim/simulation_run.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 #include "strata/core/sim/surface_springs.hpp"
@@ -98,14 +99,10 @@ struct SimulationOptions {
   /// Surface springs with yielding rest lengths (surface_springs.hpp) on the mesh's boundary
   /// edges; meshes without an embedding only.
   std::optional<SurfaceSpringSettings> surface_springs;
-  /// Rigid obstacles (obstacle.hpp) the contact points (the boundary vertices unless
-  /// `boundary_contact_points` is false, and `contact_points`) contact through a barrier (implicit
-  /// and static steps), or the DOF vertices through a projection (explicit steps). With an
+  /// Further contact points for ProblemSpec::obstacles as weighted mesh vertices (e.g. the
+  /// vertices of a bound fine surface, through their barycentric weights): the barrier and
+  /// friction act on them too and their forces reach the DOFs through the weights. With an
   /// embedding a hanging boundary vertex is tested where its constraint puts it.
-  std::vector<Obstacle> obstacles;
-  /// Further contact points as weighted mesh vertices (e.g. the vertices of a bound fine surface,
-  /// through their barycentric weights): the barrier and friction act on them too and their
-  /// forces reach the DOFs through the weights.
   std::vector<ContactPoint> contact_points;
   /// Whether every boundary vertex is a contact point (before `contact_points`). A driver whose
   /// `contact_points` already hold the boundary vertices (the hierarchy's finest-level boundary
@@ -154,9 +151,7 @@ class Simulation final : public SimulationRun {
   /// `mesh` must be validated and positively oriented (validate_tet_mesh, orient_tets).
   /// Throws InputError for a vertex without tets, invalid material / settings / regions / ground,
   /// an empty Dirichlet group or load region, or static mode without any Dirichlet group.
-  Simulation(TetMesh mesh, const Material& material, const std::vector<DirichletSpec>& dirichlet,
-             const std::vector<RegionLoad>& loads, const std::optional<GroundPlane>& ground,
-             const Vector3d& gravity, const SolverSettings& settings,
+  Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& settings,
              SimulationOptions options = {});
   ~Simulation() override;
   Simulation(const Simulation&) = delete;

@@ -36,6 +36,7 @@
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/linear_solver.hpp"
 #include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/problem_spec.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/solver_settings.hpp"
 #include "strata/core/sim/spring_set.hpp"
@@ -90,11 +91,7 @@ SpringBody skeleton_spring_body(ConstRef<MatrixX3d> surface, ConstRef<MatrixX3i>
 class SpringBodySimulation {
  public:
   /// Throws InputError for static mode, stiffness damping, invalid regions or loads.
-  SpringBodySimulation(SpringBody body, const Material& material,
-                       const std::vector<DirichletSpec>& dirichlet,
-                       const std::vector<RegionLoad>& loads,
-                       const std::optional<GroundPlane>& ground, const Vector3d& gravity,
-                       const SolverSettings& settings, std::vector<Obstacle> obstacles = {});
+  SpringBodySimulation(SpringBody body, ProblemSpec problem, const SolverSettings& settings);
 
   /// One time step. Throws DivergenceError naming the step for a non-finite state or a failed
   /// Newton solve.
