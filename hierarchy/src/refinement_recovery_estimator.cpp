@@ -2,6 +2,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -112,15 +114,52 @@ double frobenius(const Vector6d& e) {
   return std::sqrt(frobenius_sq(e));
 }
 
-/// The predicted local term δ of the parent (level `parent_level`) of eight sibling flat tets
-/// once merged [m]: the parent's share times its size (the edge of a regular tet of their total
-/// volume, twice theirs) times the largest strain error of a child not on the finest level plus
-/// the largest deviation of a child's strain from their mean, which the parent's one linear field
-/// averages away.
-double merged_local_error(const CutState& state, const RecoveryEstimate& estimate,
+/// The Green strain (Voigt [xx yy zz xy yz xz]) of `parent` once merged: of the linear field
+/// through its corners' current positions, which are vertices of the flat cut (its corner
+/// children's). Where the children turn against each other this is not their mean strain: the
+/// mean of rotations is a shrink.
+Vector6d merged_strain(const CutState& state, NodeId parent) {
+  const std::array<int, 4> corners = state.tree.tet_vertices(parent);
+  Matrix3d rest, deformed;
+  std::array<Vector3d, 4> X, x;
+  for (int i = 0; i < 4; ++i) {
+    const int v = state.flat.mesh_vertices[corners[i]];
+    STRATA_VERIFY(v >= 0, "merged_strain: a corner of a merge is not a vertex of the cut");
+    X[i] = state.flat.mesh.vertices.row(v).transpose();
+    x[i] = state.positions.segment<3>(3 * Index(v));
+  }
+  for (int j = 0; j < 3; ++j) {
+    rest.col(j) = X[j + 1] - X[0];
+    deformed.col(j) = x[j + 1] - x[0];
+  }
+  const Matrix3d F = deformed * rest.inverse();
+  const Matrix3d E = 0.5 * (F.transpose() * F - Matrix3d::Identity());
+  Vector6d voigt;
+  voigt << E(0, 0), E(1, 1), E(2, 2), E(0, 1), E(1, 2), E(0, 2);
+  return voigt;
+}
+
+/// The predicted local term δ of `parent` (level `parent_level`), the parent of eight sibling flat
+/// tets, once merged [m]: the parent's share times its size (the edge of a regular tet of their
+/// total volume, twice theirs) times the larger of two strain errors. One is the parent's own
+/// strain (merged_strain) against the recovered strains at its corners now, which is what its
+/// term reads after the merge as far as its neighbours' strains stay (children on the finest
+/// level count no term of their own, however far their neighbours' strains are from theirs: a
+/// merge inside a clamped region beside a strained one). The other is the largest strain error
+/// of a child not on the finest level, plus the largest deviation of a child's strain from their
+/// mean, which the parent's one linear field averages away, plus the difference between the
+/// parent's strain and that mean.
+double merged_local_error(const CutState& state, const RecoveryEstimate& estimate, NodeId parent,
                           const std::array<int, 8>& children, int depth, int parent_level) {
   const Siblings sibling = siblings(state, children);
   if (!(sibling.total > 0.0)) return 0.0;
+  const Vector6d parent_strain = merged_strain(state, parent);
+  double corner_difference = 0.0;
+  for (const int v : state.tree.tet_vertices(parent)) {
+    const Index mesh_vertex = state.flat.mesh_vertices[v];
+    const Vector6d recovered = estimate.recovered_strain.row(mesh_vertex).head<6>().transpose();
+    corner_difference = std::max(corner_difference, frobenius(recovered - parent_strain));
+  }
   const auto& strain = state.fields.green_strain;
   // The children's strain errors as their own local terms count them: relative to the finest
   // level, so nothing on it (the full-resolution run has the same), and the detail each child
@@ -134,8 +173,10 @@ double merged_local_error(const CutState& state, const RecoveryEstimate& estimat
           std::max(child_difference, estimate.element_local_error[children[k]] / (child_share * h));
     detail = std::max(detail, frobenius(strain.row(children[k]).transpose() - sibling.mean));
   }
+  const double own = frobenius(parent_strain - sibling.mean);
   return local_share_removed(depth, parent_level) *
-         std::cbrt(kRegularTetEdgeCubed * sibling.total) * (child_difference + detail);
+         std::cbrt(kRegularTetEdgeCubed * sibling.total) *
+         std::max(corner_difference, child_difference + detail + own);
 }
 
 /// What the terms of the estimate read, per tet and per vertex.
@@ -234,10 +275,11 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
   STRATA_VERIFY(strain.rows() == num_tets,
                 "recovery_error_estimate: the strains are not of this cut's tets");
 
+  RecoveryEstimate estimate;
   // Per vertex, row by row: the volume-weighted sum of its tets' strains (tets ascending), then
   // their volume; the sum becomes the recovered (mean) strain.
-  using RowStrains = Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>;
-  RowStrains recovered(num_vertices, 7);
+  auto& recovered = estimate.recovered_strain;
+  recovered.resize(num_vertices, 7);
   tbb::parallel_for(Index(0), num_vertices, kTetChunk, [&](Index begin) {
     const Index end = std::min(begin + kTetChunk, num_vertices);
     for (Index v = begin; v < end; ++v) {
@@ -255,7 +297,6 @@ RecoveryEstimate recovery_error_estimate(const CutState& state) {
     }
   });
 
-  RecoveryEstimate estimate;
   estimate.element_error_sq.resize(num_tets);
   estimate.element_raw_error_sq.resize(num_tets);
   const int depth = state.tree.max_level();
@@ -394,7 +435,8 @@ BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimat
   const TetTree& tree = state.tree;
   const FlatTreeMesh& flat = state.flat;
   const Index num_tets = flat.mesh.tets.rows();
-  STRATA_VERIFY(estimate.element_raw_error_sq.size() == num_tets,
+  STRATA_VERIFY(estimate.element_raw_error_sq.size() == num_tets &&
+                    estimate.recovered_strain.rows() == flat.mesh.vertices.rows(),
                 "merges_within_budget: the estimate is not of this state");
   std::vector<int> node_tet(static_cast<std::size_t>(tree.pool_size()), -1);
   for (Index t = 0; t < num_tets; ++t)
@@ -438,7 +480,7 @@ BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimat
     // budget is not made (whatever the energy-norm estimate allows): the merged node may not be
     // refined again for a while (min_steps_between_changes).
     if (reference_displacement > 0.0 &&
-        merged_local_error(state, estimate, children, depth, level) >
+        merged_local_error(state, estimate, parent, children, depth, level) >
             kMergeLocalMargin * budget * reference_displacement)
       continue;
     const double parent_sq = std::max(4.0 * children_sq, children_sq + merge_loss(state, children));

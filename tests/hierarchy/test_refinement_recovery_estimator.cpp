@@ -320,6 +320,51 @@ TEST(MergeBudget, KeepsNoMergeWhoseLocalTermWouldExceedTheBudget) {
         << "root " << parent;
 }
 
+TEST(MergeBudget, AStillRegionBesideAStrainedOneMergesOnlyAwayFromIt) {
+  // A slab at rest for x ≤ 0.5 (as inside a clamp) and bent beyond, on its finest level. The
+  // children of a root in the still region carry no strain at all, but a root that touches
+  // x = 0.5, once merged, is one coarse tet whose corners there see the strained side's
+  // recovered strain: its local term is large. Merges of roots away from x = 0.5 are free.
+  TetTree tree(slab(), 1);
+  const auto bend = [](const Vector3d& X) -> Vector3d {
+    const double d = std::max(0.0, X.x() - 0.5);
+    return Vector3d(0, 0, 0.02 * d * d);
+  };
+  ActiveCut cut = ActiveCut::uniform(tree, 1);
+  const test::CutSnapshot s = make_snapshot(cut, test_material(), bend, {});
+  const RecoveryEstimate estimate = recovery_error_estimate(s.state());
+  ASSERT_EQ(estimate.local_error, 0.0);  // the finest level
+  std::vector<NodeId> still, touching;
+  for (const NodeId root : roots(tree)) {
+    const Matrix3x4d corners = tree.tet_positions(root);
+    const double right = corners.row(0).maxCoeff();
+    if (right < 0.5 - 1e-9) still.push_back(root);
+    if (std::abs(right - 0.5) < 1e-9) touching.push_back(root);
+  }
+  ASSERT_FALSE(still.empty());
+  ASSERT_FALSE(touching.empty());
+  std::vector<NodeId> candidates = still;
+  candidates.insert(candidates.end(), touching.begin(), touching.end());
+  std::sort(candidates.begin(), candidates.end());
+  const double budget = 0.002;
+  const BudgetedMerges merges = merges_within_budget(s.state(), estimate, candidates, budget);
+  EXPECT_EQ(merges.kept, still);
+  for (const NodeId parent : merges.kept)
+    cut.coarsen(parent);
+  const RecoveryEstimate merged =
+      recovery_error_estimate(make_snapshot(cut, test_material(), bend, {}).state());
+  EXPECT_LE(merged.local_error, budget);
+  // Each root touching x = 0.5 merged as well would have taken the local term over the budget.
+  for (const NodeId parent : touching) {
+    ActiveCut more = cut;
+    more.coarsen(parent);
+    EXPECT_GT(
+        recovery_error_estimate(make_snapshot(more, test_material(), bend, {}).state()).local_error,
+        budget)
+        << "root " << parent;
+  }
+}
+
 TEST(MergeBudget, KeepsTheMergesWhosePredictedEstimateFitsTheBudget) {
   TetTree tree(slab(), 2);
   const ActiveCut cut = ActiveCut::uniform(tree, 1);

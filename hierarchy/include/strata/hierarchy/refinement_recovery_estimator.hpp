@@ -104,6 +104,9 @@ struct RecoveryEstimate {
   /// error across the tet's size amounts to, the part refinement to the finest level removes
   /// (zero on the finest level, whose strain error the full-resolution run shares).
   VectorXd element_local_error;
+  /// Per flat vertex v: the recovered strain E*_v (Voigt [xx yy zz xy yz xz]), the rest-volume
+  /// weighted mean of its tets' Green strains, then the rest volume of those tets [m³].
+  Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor> recovered_strain;
   /// max(largest vertex displacement of this state, state.solution_displacement_scale) [m].
   double reference_displacement = 0.0;
   /// The local estimate e_loc = max_t δ_t / reference_displacement.
