@@ -144,7 +144,12 @@ TEST(SceneParser, WrongTypes) {
   EXPECT_EQ(parse_error(scene), "scene.json: gravity: must be an array of 3 numbers");
   scene = minimal_scene();
   scene["output"] = {{"vtk", 1}};
-  EXPECT_THAT(parse_error(scene), HasSubstr("scene.json: output.vtk: must be true or false"));
+  EXPECT_EQ(parse_error(scene),
+            "scene.json: output.vtk: must be true, false or \"surface\", got 1");
+  scene = minimal_scene();
+  scene["output"] = {{"vtk", "yes"}};
+  EXPECT_EQ(parse_error(scene),
+            "scene.json: output.vtk: must be true, false or \"surface\", got \"yes\"");
   scene = minimal_scene();
   scene["mesh"]["box"]["cells"] = {4, 1.5, 1};
   EXPECT_EQ(parse_error(scene), "scene.json: mesh.box.cells.1: must be an integer");

@@ -407,6 +407,35 @@ TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
     EXPECT_GE(sim.positions()[i], -1e-12);
 }
 
+TEST(ContactScenes, AnObstacleThatReachesAHeldPointIsNamedInTheError) {
+  // A wall moving at 0.1 m/s towards the cube's x = 0.1 face, 0.3 mm away, while the cube's
+  // bottom face is clamped: within a few 4 ms steps the wall passes the clamped vertices on that
+  // face, which cannot give way, and squeezes the free ones beside them. The error says so, and
+  // why Newton stopped.
+  DirichletSpec clamp;
+  clamp.name = "fixed[0]";
+  clamp.region = PlaneRegion{Vector3d::Zero(), Vector3d::UnitZ(), 0.0};
+  Obstacle wall = plane_obstacle("obstacles.0", Vector3d(0.1003, 0, 0), -Vector3d::UnitX());
+  wall.velocity = Vector3d(-0.1, 0, 0);
+  SolverSettings settings;
+  settings.dt = 4e-3;
+  settings.duration = 0.02;
+  Simulation sim(cube(), {.material = rubber(), .dirichlet = {clamp}, .obstacles = {wall}},
+                 settings);
+  try {
+    while (!sim.finished())
+      sim.advance();
+    FAIL() << "no error";
+  } catch (const DivergenceError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("Newton did not converge at step "), std::string::npos) << message;
+    EXPECT_NE(message.find(", stopped at "), std::string::npos) << message;
+    EXPECT_NE(message.find("obstacles.0 has reached a point held by fixed[0] at (0.1, "),
+              std::string::npos)
+        << message;
+  }
+}
+
 TEST(ContactScenes, StartingInsideAnObstacleIsAnError) {
   SolverSettings settings;
   try {

@@ -80,6 +80,20 @@ class InexactNewtonForcing {
 
 }  // namespace
 
+std::string describe(NewtonFailure failure) {
+  switch (failure) {
+    case NewtonFailure::iteration_limit:
+      return "the iteration limit";
+    case NewtonFailure::linear_solve:
+      return "no solvable linear system";
+    case NewtonFailure::no_descent:
+      return "no step that lowers the energy or its gradient";
+    case NewtonFailure::none:
+      break;
+  }
+  return "";
+}
+
 std::string to_string(NewtonCriterion criterion) {
   switch (criterion) {
     case NewtonCriterion::residual:
@@ -136,7 +150,10 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
   while (true) {
     if (result.residual <= target || reduction.num_free() == 0)
       return finish(NewtonCriterion::residual);
-    if (result.iterations >= settings.max_iterations) return result;
+    if (result.iterations >= settings.max_iterations) {
+      result.failure = NewtonFailure::iteration_limit;
+      return result;
+    }
     ++result.iterations;
     solver.set_relative_tolerance(forcing.next(result.residual));
 
@@ -156,7 +173,10 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
     if (!solved) {
       objective.hessian(x, hessian, true);
       reduction.restrict_matrix(hessian, reduced_hessian);
-      if (!solve_with_shift(solver, reduced_hessian, -g, step)) return result;
+      if (!solve_with_shift(solver, reduced_hessian, -g, step)) {
+        result.failure = NewtonFailure::linear_solve;
+        return result;
+      }
       ++result.projected_hessian_iterations;
     }
     choice.iteration_done();
@@ -224,6 +244,7 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
         if (increment <= settings.stall_tolerance * displacement_scale(settings, x) ||
             result.residual <= settings.stall_residual_tolerance * settings.force_scale)
           return finish(NewtonCriterion::stall);
+        result.failure = NewtonFailure::no_descent;
         return result;
       }
     }

@@ -304,8 +304,7 @@ void Simulation::advance() {
   }
   const NewtonResult result = m_stepper->step(t0, t1, h, m_x, m_v);
   record_newton(result);
-  if (!result.converged)
-    throw_newton_failure(std::string(m_stepper_traits->name), result.iterations, result.residual);
+  if (!result.converged) throw_newton_failure(std::string(m_stepper_traits->name), result);
   if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
   if (has_obstacles() && m_stepper_traits->is_explicit)
     project_obstacle_contact(m_obstacles, t1, m_x, m_v, m_constrained);
@@ -490,22 +489,54 @@ void Simulation::update_plastic_state(double t0, double t1, double h, const Vect
     if (!result.converged)
       throw_newton_failure(
           std::string(m_stepper_traits->name) + " (plastic pass " + std::to_string(pass + 1) + ")",
-          result.iterations, result.residual);
+          result);
     if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
     update_mesh_state();
   }
 }
 
-void Simulation::throw_newton_failure(const std::string& context, int iterations,
-                                      double residual) const {
+void Simulation::throw_newton_failure(const std::string& context,
+                                      const NewtonResult& result) const {
   const long step = m_steps + 1;
   const double t = is_static() ? static_cast<double>(step) / m_settings.load_steps
                                : static_cast<double>(step) * m_settings.dt;
+  std::string reason = describe(result.failure);
+  if (!reason.empty()) reason = ", stopped at " + reason;
   throw DivergenceError(context + ": Newton did not converge at step " + std::to_string(step) +
                             (is_static() ? ", load factor " : ", t = ") + std::to_string(t) +
-                            " after " + std::to_string(iterations) + " iterations (gradient norm " +
-                            format_number(residual) + " N)",
+                            " after " + std::to_string(result.iterations) +
+                            " iterations (gradient norm " + format_number(result.residual) + " N)" +
+                            reason + held_contact(is_static() ? 0.0 : t),
                         step, t);
+}
+
+std::string Simulation::held_contact(double t) const {
+  if (!has_obstacles()) return "";
+  for (const ContactPoint& point : m_contact_points) {
+    bool held = true;
+    Vector3d p = Vector3d::Zero();
+    int holder = -1;  // a DOF vertex of the point with a weight
+    for (std::size_t k = 0; k < point.vertices.size(); ++k) {
+      const Index q = point.vertices[k];
+      p += point.weights[k] * m_x.segment<3>(3 * q);
+      if (std::abs(point.weights[k]) < 1e-9) continue;  // a point on the face opposite q
+      held = held && m_constrained[3 * q] && m_constrained[3 * q + 1] && m_constrained[3 * q + 2];
+      holder = point.vertices[k];
+    }
+    if (!held || holder < 0) continue;
+    for (const Obstacle& obstacle : m_obstacles) {
+      Vector3d gradient;
+      if (!(obstacle.distance_at(p, t, gradient) <= 0.0)) continue;
+      std::string group;
+      for (const DirichletGroup& g : m_groups)
+        if (std::binary_search(g.vertices.begin(), g.vertices.end(), holder)) group = g.spec.name;
+      return "; " + obstacle.name + " has reached a point held by " +
+             (group.empty() ? std::string("a Dirichlet group") : group) + " at (" +
+             format_number(p.x()) + ", " + format_number(p.y()) + ", " + format_number(p.z()) +
+             "), which cannot give way to it";
+    }
+  }
+  return "";
 }
 
 void Simulation::resolve_static(const VectorXd& contact_reference) {

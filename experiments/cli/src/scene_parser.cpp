@@ -348,11 +348,12 @@ OutputSpec parse_output(const SceneValue& value) {
   }
   if (value.has("vtk")) {
     const SceneValue vtk = value.at("vtk");
-    if (vtk.json().is_string()) {
-      vtk.choice({"surface"});
+    if (vtk.json().is_string() && vtk.string() == "surface") {
       output.vtk_mesh = false;
-    } else {
+    } else if (vtk.json().is_boolean()) {
       output.vtk = vtk.boolean();
+    } else {
+      vtk.fail("must be true, false or \"surface\", got " + vtk.json().dump());
     }
   }
   if (value.has("vtk_encoding")) {

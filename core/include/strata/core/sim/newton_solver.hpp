@@ -67,15 +67,24 @@ struct NewtonSettings {
 enum class NewtonCriterion { none, residual, increment, stall };
 std::string to_string(NewtonCriterion criterion);  ///< "none" | "residual" | "increment" | "stall"
 
+/// Why a Newton solve that did not converge stopped: its iteration limit; a linear system no
+/// diagonal shift made solvable; or no step along the Newton direction lowering the energy or
+/// the gradient's norm (the residual stalled above every convergence bound).
+enum class NewtonFailure { none, iteration_limit, linear_solve, no_descent };
+/// "" | "the iteration limit" | "no solvable linear system" | "no step that lowers the energy or
+/// its gradient"
+std::string describe(NewtonFailure failure);
+
 struct NewtonResult {
   bool converged = false;
   NewtonCriterion criterion = NewtonCriterion::none;
   int iterations = 0;
-  int exact_hessian_iterations = 0;      ///< iterations solved with the exact Hessian
-  int projected_hessian_iterations = 0;  ///< … with the PSD-projected one
-  double residual = 0.0;                 ///< final ‖g_free‖ [N]
-  double residual_target = 0.0;          ///< the residual criterion's bound [N]
-  std::vector<double> residuals;         ///< ‖g_free‖ at the start and after each iteration [N]
+  int exact_hessian_iterations = 0;             ///< iterations solved with the exact Hessian
+  int projected_hessian_iterations = 0;         ///< … with the PSD-projected one
+  double residual = 0.0;                        ///< final ‖g_free‖ [N]
+  double residual_target = 0.0;                 ///< the residual criterion's bound [N]
+  NewtonFailure failure = NewtonFailure::none;  ///< why it stopped, when not converged
+  std::vector<double> residuals;  ///< ‖g_free‖ at the start and after each iteration [N]
 };
 
 /// Round-off level of the elastic forces of `model` near the rest state [N]:

@@ -285,8 +285,12 @@ class Simulation final : public SimulationRun {
   void update_plastic_state(double t0, double t1, double h, const VectorXd& q_start,
                             const VectorXd& v_start);
   bool is_static() const;
-  [[noreturn]] void throw_newton_failure(const std::string& context, int iterations,
-                                         double residual) const;
+  [[noreturn]] void throw_newton_failure(const std::string& context,
+                                         const NewtonResult& result) const;
+  /// With obstacles: "; <obstacle> has reached a point held by <group> …" for the first contact
+  /// point whose DOFs Dirichlet groups hold all of and that lies inside an obstacle at time t (a
+  /// contact no step can resolve: its barrier is infinite); "" otherwise.
+  std::string held_contact(double t) const;
 
   TetMesh m_mesh;
   Material m_material;
