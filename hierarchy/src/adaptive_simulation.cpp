@@ -973,7 +973,7 @@ int AdaptiveSimulation::max_refine_level() const {
   return max_level < 0 ? m_tree->max_level() : std::min(max_level, m_tree->max_level());
 }
 
-RecoveryEstimate AdaptiveSimulation::estimate_error() {
+const RecoveryEstimate& AdaptiveSimulation::estimate_error() {
   if (!m_estimate_valid) {
     const Simulation& sim = *m_simulation;
     const TetFields fields = sim.model().tet_fields(sim.positions());
@@ -1069,7 +1069,7 @@ void AdaptiveSimulation::record_sample() {
   sample.hanging = m_constrained->constraints.num_hanging();
   if (m_settings.mode != HierarchyMode::full &&
       !m_at_full_resolution) {  // full resolution: zero by definition
-    const RecoveryEstimate estimate = estimate_error();
+    const RecoveryEstimate& estimate = estimate_error();
     sample.estimated_error = m_estimate_scale * estimate.relative_error;
     sample.estimated_energy_error = estimate.relative_energy_error;
     sample.estimated_upper_error = estimate.upper_error;

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "strata/core/common/error.hpp"
+#include "strata/core/fem/green_strain.hpp"
+#include "strata/core/fem/isotropic_stress.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 
 namespace strata {
@@ -62,7 +64,8 @@ double upper_tolerance(const RecoveryEstimate& estimate, double tolerance) {
 }
 
 /// Eight sibling flat tets: their rest volumes, total volume and volume-weighted mean Green
-/// strain Ē (the strain of the parent's one linear field).
+/// strain Ē (near the strain of the parent's one linear field where the children turn alike,
+/// merged_strain).
 struct Siblings {
   std::array<double, 8> volume{};
   double total = 0.0;
@@ -132,11 +135,7 @@ Vector6d merged_strain(const CutState& state, NodeId parent) {
     rest.col(j) = X[j + 1] - X[0];
     deformed.col(j) = x[j + 1] - x[0];
   }
-  const Matrix3d F = deformed * rest.inverse();
-  const Matrix3d E = 0.5 * (F.transpose() * F - Matrix3d::Identity());
-  Vector6d voigt;
-  voigt << E(0, 0), E(1, 1), E(2, 2), E(0, 1), E(1, 2), E(0, 2);
-  return voigt;
+  return to_voigt(green_strain(deformed * rest.inverse()));
 }
 
 /// The predicted local term δ of `parent` (level `parent_level`), the parent of eight sibling flat

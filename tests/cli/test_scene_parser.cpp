@@ -145,7 +145,7 @@ TEST(SceneParser, WrongTypes) {
   scene = minimal_scene();
   scene["output"] = {{"vtk", 1}};
   EXPECT_EQ(parse_error(scene),
-            "scene.json: output.vtk: must be true, false or \"surface\", got 1");
+            "scene.json: output.vtk: must be true, false or \"surface\", got a number");
   scene = minimal_scene();
   scene["output"] = {{"vtk", "yes"}};
   EXPECT_EQ(parse_error(scene),

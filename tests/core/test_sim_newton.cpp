@@ -201,6 +201,30 @@ class StalledGradientTerm final : public EnergyTerm {
   double m_k, m_delta;
 };
 
+TEST(Newton, ASolveStoppedByItsIterationLimitSaysSo) {
+  const Cantilever c;
+  EnergySum energy(c.embedded->stiffness_pattern());
+  energy.emplace<ElasticTerm>(*c.embedded);
+  energy.emplace<ExternalWorkTerm>(c.external);
+  const DofReduction reduction(c.embedded->stiffness_pattern(), c.constrained);
+  SpdSolver solver(LinearSolverKind::cholmod);
+  NewtonSettings settings;
+  settings.rest_positions = &c.model->rest_positions();
+  settings.max_iterations = 1;  // the bending cantilever needs several
+  VectorXd q = c.model->rest_positions();
+  const NewtonResult r = newton_minimize(energy, reduction, solver, settings, q);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_EQ(r.failure, NewtonFailure::iteration_limit);
+  EXPECT_EQ(describe(r.failure), "the iteration limit");
+  settings.max_iterations = 50;
+  q = c.model->rest_positions();
+  const NewtonResult full = newton_minimize(energy, reduction, solver, settings, q);
+  EXPECT_TRUE(full.converged);
+  EXPECT_GT(full.iterations, 1);
+  EXPECT_EQ(full.failure, NewtonFailure::none);
+}
+
 TEST(Newton, StalledResidualIsConvergedOnlyWhenSmallAgainstTheForceScale) {
   const Cantilever c;
   const double delta = 1e-6;  // the stalled residual [N]
@@ -227,8 +251,10 @@ TEST(Newton, StalledResidualIsConvergedOnlyWhenSmallAgainstTheForceScale) {
     if (delta <= settings.stall_residual_tolerance * force_scale) {
       EXPECT_TRUE(r.converged) << "force scale " << force_scale;
       EXPECT_EQ(r.criterion, NewtonCriterion::stall);
+      EXPECT_EQ(r.failure, NewtonFailure::none);
     } else {
       EXPECT_FALSE(r.converged) << "force scale " << force_scale;
+      EXPECT_EQ(r.failure, NewtonFailure::no_descent);
     }
   }
 }

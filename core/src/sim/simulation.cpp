@@ -500,25 +500,39 @@ void Simulation::throw_newton_failure(const std::string& context,
   const long step = m_steps + 1;
   const double t = is_static() ? static_cast<double>(step) / m_settings.load_steps
                                : static_cast<double>(step) * m_settings.dt;
-  std::string reason = describe(result.failure);
-  if (!reason.empty()) reason = ", stopped at " + reason;
   throw DivergenceError(context + ": Newton did not converge at step " + std::to_string(step) +
                             (is_static() ? ", load factor " : ", t = ") + std::to_string(t) +
-                            " after " + std::to_string(result.iterations) +
-                            " iterations (gradient norm " + format_number(result.residual) + " N)" +
-                            reason + held_contact(is_static() ? 0.0 : t),
+                            newton_failure_detail(result, t),
                         step, t);
+}
+
+std::string Simulation::newton_failure_detail(const NewtonResult& result, double t) const {
+  std::string reason = describe(result.failure);
+  if (!reason.empty()) reason = ", stopped at " + reason;
+  return " after " + std::to_string(result.iterations) + " iterations (gradient norm " +
+         format_number(result.residual) + " N)" + reason + held_contact(t);
 }
 
 std::string Simulation::held_contact(double t) const {
   if (!has_obstacles()) return "";
+  // The held DOFs where the failed solve put them: their targets at t (the load factor in static
+  // runs, whose obstacles stand still).
+  VectorXd x = m_x, v = m_v;
+  if (is_static())
+    apply_dirichlet(m_groups, m_embedded->rest_positions(), t, t, 0.0, x, v);
+  else
+    m_system->apply_constraints(t, x, v);
+  const double obstacle_time = is_static() ? 0.0 : t;
+  // The barrier is infinite where a point is d̂ deep (energy/contact_term.hpp): no step moves a
+  // point whose weighted DOF vertices are all held.
+  const double depth = contact_settings().distance;
   for (const ContactPoint& point : m_contact_points) {
     bool held = true;
-    Vector3d p = Vector3d::Zero();
     int holder = -1;  // a DOF vertex of the point with a weight
+    Vector3d p = Vector3d::Zero();
     for (std::size_t k = 0; k < point.vertices.size(); ++k) {
       const Index q = point.vertices[k];
-      p += point.weights[k] * m_x.segment<3>(3 * q);
+      p += point.weights[k] * x.segment<3>(3 * q);
       if (std::abs(point.weights[k]) < 1e-9) continue;  // a point on the face opposite q
       held = held && m_constrained[3 * q] && m_constrained[3 * q + 1] && m_constrained[3 * q + 2];
       holder = point.vertices[k];
@@ -526,14 +540,17 @@ std::string Simulation::held_contact(double t) const {
     if (!held || holder < 0) continue;
     for (const Obstacle& obstacle : m_obstacles) {
       Vector3d gradient;
-      if (!(obstacle.distance_at(p, t, gradient) <= 0.0)) continue;
-      std::string group;
+      if (!(obstacle.distance_at(p, obstacle_time, gradient) + depth <= 0.0)) continue;
+      std::string group = "a Dirichlet group";
       for (const DirichletGroup& g : m_groups)
-        if (std::binary_search(g.vertices.begin(), g.vertices.end(), holder)) group = g.spec.name;
-      return "; " + obstacle.name + " has reached a point held by " +
-             (group.empty() ? std::string("a Dirichlet group") : group) + " at (" +
+        if (std::binary_search(g.vertices.begin(), g.vertices.end(), holder)) {
+          group = g.spec.name;
+          break;
+        }
+      return "; " + obstacle.name + " has reached a point held by " + group + " at (" +
              format_number(p.x()) + ", " + format_number(p.y()) + ", " + format_number(p.z()) +
-             "), which cannot give way to it";
+             ") deeper than its contact distance (" + format_number(depth) +
+             " m), which the point cannot give way to";
     }
   }
   return "";
@@ -548,9 +565,7 @@ void Simulation::resolve_static(const VectorXd& contact_reference) {
   if (!result.converged)
     throw DivergenceError("static: Newton did not converge re-solving load step " +
                               std::to_string(m_steps) + ", load factor " + std::to_string(lambda) +
-                              " after " + std::to_string(result.iterations) +
-                              " iterations (gradient norm " + format_number(result.residual) +
-                              " N)",
+                              newton_failure_detail(result, lambda),
                           m_steps, lambda);
   update_mesh_state();
   // Plastic flow from the carried state, with further passes until it settles.

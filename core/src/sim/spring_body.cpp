@@ -363,7 +363,9 @@ void SpringBodySimulation::step_implicit(double t1) {
     m_v = v0;
   }
   throw DivergenceError("step " + std::to_string(m_steps + 1) + " (t = " + std::to_string(t1) +
-                            " s): Newton did not converge, nor in 16 substeps",
+                            " s): Newton did not converge, nor in 16 substeps (the last stopped "
+                            "at " +
+                            describe(m_last_failure) + ")",
                         m_steps + 1, t1);
 }
 
@@ -416,7 +418,10 @@ bool SpringBodySimulation::try_implicit(double t1, double h) {
                           std::abs(f_ext.dot(q)) + m_mass.sum() * size * size / (h * h) * 1e-6;
   const NewtonResult result = newton_minimize(energy, *m_reduction, *m_solver, settings, q);
   m_newton_iterations += result.iterations;
-  if (!result.converged) return false;
+  if (!result.converged) {
+    m_last_failure = result.failure;
+    return false;
+  }
   m_v = (q - m_x) / h;
   m_x = q;
   apply_constraints(t1, m_x, m_v);

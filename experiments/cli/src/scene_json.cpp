@@ -21,6 +21,10 @@ std::string join_path(const std::string& path, const std::string& key) {
 
 }  // namespace
 
+std::string SceneValue::describe() const {
+  return m_value.is_string() ? m_value.dump() : type_name(m_value);
+}
+
 void SceneValue::fail(const std::string& message) const {
   throw SceneKeyError(m_file, m_path, message, false);
 }

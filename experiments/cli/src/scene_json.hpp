@@ -19,6 +19,9 @@ class SceneValue {
 
   const nlohmann::json& json() const { return m_value; }
   const std::string& path() const { return m_path; }
+  /// What the value is, for messages: a string quoted, else "a number", "a boolean", "an array",
+  /// "an object" or "null".
+  std::string describe() const;
 
   /// Throws SceneKeyError "<file>: <path>: <message>".
   [[noreturn]] void fail(const std::string& message) const;

@@ -353,7 +353,7 @@ OutputSpec parse_output(const SceneValue& value) {
     } else if (vtk.json().is_boolean()) {
       output.vtk = vtk.boolean();
     } else {
-      vtk.fail("must be true, false or \"surface\", got " + vtk.json().dump());
+      vtk.fail("must be true, false or \"surface\", got " + vtk.describe());
     }
   }
   if (value.has("vtk_encoding")) {

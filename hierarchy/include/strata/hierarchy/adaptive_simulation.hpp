@@ -321,7 +321,7 @@ class AdaptiveSimulation final : public SimulationRun {
   void move_to_window(std::size_t w, bool initial);
   std::size_t m_window = 0;
   /// The estimate of the current state; raises the run's energy scale to its energy norm.
-  RecoveryEstimate estimate_error();
+  const RecoveryEstimate& estimate_error();
   int max_refine_level() const;  ///< the deepest level refinement may reach
   bool children_stable(NodeId n) const;
   /// Whether an active tet of the cut may refine: below max_refine_level() and, with an explicit

@@ -143,9 +143,12 @@ struct BudgetedMerges {
 /// alone would leave, and each is kept if the predicted √(z c) with it and the merges kept
 /// before stays within the budget. Every rise is ≥ 0, so a state whose estimate already exceeds
 /// the budget keeps none. A state without deformation keeps every merge. For e_loc: while it
-/// exceeds the budget nothing merges, and a merge whose parent's predicted δ (its size times its
-/// children's share-weighted strain error, zero on the finest level, plus the largest deviation
-/// of a child's strain from their mean) exceeds half the budget times max |u| is not made.
+/// exceeds the budget nothing merges, and a merge whose parent's predicted δ exceeds half the
+/// budget times max |u| is not made. That δ is its share times its size times the larger of its
+/// own strain (of the linear field through its corners' current positions) against the
+/// recovered strains at its corners, and its children's share-weighted strain error (zero on the
+/// finest level) plus the largest deviation of a child's strain from their mean plus its own
+/// strain's difference from that mean. `estimate` must be recovery_error_estimate(state).
 BudgetedMerges merges_within_budget(const CutState& state, const RecoveryEstimate& estimate,
                                     const std::vector<NodeId>& parents, double budget);
 
@@ -156,7 +159,7 @@ class RecoveryIndicator final : public RefinementIndicator {
   std::string name() const override { return "recovery"; }
   void evaluate(const CutState& state, VectorXd& eta) const override;
   /// The energy a merge removes, Σ_k 2 V_k ψ(E_k − Ē) over the children (Ē their
-  /// volume-weighted mean Green strain: the parent's one linear field), in the measure of the
+  /// volume-weighted mean Green strain), in the measure of the
   /// parent's level against the finest and normalised by the tet's share of the tolerance as η:
   /// siblings in a region of low strain merge even where their stresses differ relatively.
   double merge_indicator(const CutState& state, const std::array<int, 8>& children,

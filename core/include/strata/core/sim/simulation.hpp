@@ -287,9 +287,13 @@ class Simulation final : public SimulationRun {
   bool is_static() const;
   [[noreturn]] void throw_newton_failure(const std::string& context,
                                          const NewtonResult& result) const;
+  /// " after N iterations (gradient norm …), stopped at <why>" and held_contact(t), for a Newton
+  /// solve that did not converge at time (static: load factor) t.
+  std::string newton_failure_detail(const NewtonResult& result, double t) const;
   /// With obstacles: "; <obstacle> has reached a point held by <group> …" for the first contact
-  /// point whose DOFs Dirichlet groups hold all of and that lies inside an obstacle at time t (a
-  /// contact no step can resolve: its barrier is infinite); "" otherwise.
+  /// point whose weighted DOF vertices Dirichlet groups hold all of and that lies at least the
+  /// contact distance d̂ inside an obstacle at time (static: load factor) t, where its barrier is
+  /// infinite and no step can lower it; "" otherwise.
   std::string held_contact(double t) const;
 
   TetMesh m_mesh;

@@ -36,6 +36,7 @@
 #include "strata/core/sim/ground_contact.hpp"
 #include "strata/core/sim/linear_solver.hpp"
 #include "strata/core/sim/loads.hpp"
+#include "strata/core/sim/newton_solver.hpp"
 #include "strata/core/sim/problem_spec.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/solver_settings.hpp"
@@ -146,6 +147,7 @@ class SpringBodySimulation {
   long m_steps = 0;
   double m_stable_dt = 0.0;
   long m_newton_iterations = 0;
+  NewtonFailure m_last_failure = NewtonFailure::none;  ///< of the last solve that failed
   SparseMatrixd m_pattern;
   /// Implicit steps: the free-DOF reduction and the solver, kept so that the symbolic
   /// factorisation is done once.
