@@ -225,6 +225,45 @@ TEST(Newton, ASolveStoppedByItsIterationLimitSaysSo) {
   EXPECT_EQ(full.failure, NewtonFailure::none);
 }
 
+TEST(Newton, OutOfIterationsWithAResidualARoundOffStallWouldAcceptIsConverged) {
+  // The cantilever's static solve with an unreachable residual target, cut off after three
+  // iterations: against a force scale its residual is 1e-5 of by then it has stalled (converged,
+  // as a stall); against one ten thousand times smaller it has not (the iteration limit).
+  const Cantilever c;
+  EnergySum energy(c.embedded->stiffness_pattern());
+  energy.emplace<ElasticTerm>(*c.embedded);
+  energy.emplace<ExternalWorkTerm>(c.external);
+  const DofReduction reduction(c.embedded->stiffness_pattern(), c.constrained);
+  SpdSolver solver(LinearSolverKind::cholmod);
+  NewtonSettings settings;
+  settings.tolerance = 0.0;
+  settings.residual_floor = 0.0;
+  settings.increment_tolerance = 0.0;
+  settings.step_tolerance = 0.0;
+  settings.rest_positions = &c.model->rest_positions();
+  settings.max_iterations = 3;
+  VectorXd q = c.model->rest_positions();
+  const NewtonResult probe = newton_minimize(energy, reduction, solver, settings, q);
+  ASSERT_FALSE(probe.converged);
+  ASSERT_EQ(probe.failure, NewtonFailure::iteration_limit);
+  ASSERT_GT(probe.residual, 0.0);
+  for (const double factor : {2.0, 2e-4}) {
+    settings.force_scale = factor * probe.residual / settings.stall_residual_tolerance;
+    q = c.model->rest_positions();
+    const NewtonResult r = newton_minimize(energy, reduction, solver, settings, q);
+    EXPECT_EQ(r.iterations, 3);
+    EXPECT_DOUBLE_EQ(r.residual, probe.residual);
+    if (factor > 1.0) {
+      EXPECT_TRUE(r.converged);
+      EXPECT_EQ(r.criterion, NewtonCriterion::stall);
+      EXPECT_EQ(r.failure, NewtonFailure::none);
+    } else {
+      EXPECT_FALSE(r.converged);
+      EXPECT_EQ(r.failure, NewtonFailure::iteration_limit);
+    }
+  }
+}
+
 TEST(Newton, StalledResidualIsConvergedOnlyWhenSmallAgainstTheForceScale) {
   const Cantilever c;
   const double delta = 1e-6;  // the stalled residual [N]

@@ -151,6 +151,11 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
     if (result.residual <= target || reduction.num_free() == 0)
       return finish(NewtonCriterion::residual);
     if (result.iterations >= settings.max_iterations) {
+      // Out of iterations with the residual as small against the forces at work as a stall
+      // accepts: a solve creeping at round-off, converged as a stall.
+      if (result.iterations > 0 &&
+          result.residual <= settings.stall_residual_tolerance * settings.force_scale)
+        return finish(NewtonCriterion::stall);
       result.failure = NewtonFailure::iteration_limit;
       return result;
     }

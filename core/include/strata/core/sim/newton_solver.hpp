@@ -55,7 +55,8 @@ struct NewtonSettings {
   double stall_tolerance = 1e-7;
   /// A stalled residual also counts as converged when ‖g_free‖ ≤ this × force_scale: far below
   /// what engineering solvers accept (CalculiX's default is 5·10⁻³ of the mean force), at a point
-  /// where the line search can no longer resolve E.
+  /// where the line search can no longer resolve E. So does a solve that reaches max_iterations
+  /// with its residual within this bound (still creeping at round-off).
   double stall_residual_tolerance = 1e-5;
   /// Try the exact Hessian first (solvers that detect indefiniteness).
   bool exact_hessian = true;
