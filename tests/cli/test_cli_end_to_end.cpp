@@ -519,6 +519,13 @@ TEST(CliEndToEnd, KeysTheRunDoesNotUseAreWarnedAbout) {
   scene["solver"]["dt"] = 0.01;
   EXPECT_EQ(warnings(scene),
             "strata: warning: scene.json: solver.dt: applies to dynamic runs only (ignored)\n");
+  scene = bar_scene();  // static: the obstacles stand where they are at t = 0
+  scene["obstacles"] = json::parse(
+      R"([{"plane": {"point": [0, 0, -10], "normal": [0, 0, 1]}},
+          {"plane": {"point": [0, 0, -20], "normal": [0, 0, 1]}, "motion": {"velocity": [0, 0, 1]}}])");
+  EXPECT_EQ(warnings(scene),
+            "strata: warning: scene.json: obstacles.1.motion: applies to dynamic runs only "
+            "(ignored)\n");
   scene = bar_scene();
   scene["solver"] =
       json::parse(R"({"mode": "dynamic", "dt": 0.01, "duration": 0.01, "load_steps": 4})");

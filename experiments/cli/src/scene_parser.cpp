@@ -613,6 +613,14 @@ Scene parse_scene(const nlohmann::json& root, const std::filesystem::path& file)
                                      ": applies to dynamic runs only (ignored)");
     if (dynamic && solver.has("load_steps"))
       scene.ignored_keys.push_back("solver.load_steps: applies to static runs only (ignored)");
+    // Static runs place the obstacles where they stand at t = 0.
+    if (!dynamic && top.has("obstacles")) {
+      const std::vector<SceneValue> obstacles = top.at("obstacles").elements();
+      for (std::size_t i = 0; i < obstacles.size(); ++i)
+        if (obstacles[i].has("motion"))
+          scene.ignored_keys.push_back("obstacles." + std::to_string(i) +
+                                       ".motion: applies to dynamic runs only (ignored)");
+    }
     if (dynamic && scene.solver.duration < scene.solver.dt * (1.0 - 1e-9)) {
       std::ostringstream warning;
       warning << "solver.duration: " << scene.solver.duration << " s is shorter than solver.dt "
