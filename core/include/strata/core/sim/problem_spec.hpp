@@ -20,16 +20,16 @@
 namespace strata {
 
 struct ProblemSpec {
-  Material material;
-  std::vector<DirichletSpec> dirichlet;  ///< fixed and prescribed groups
-  std::vector<RegionLoad> loads;         ///< total forces on regions
-  Vector3d gravity = Vector3d::Zero();   ///< [m/s²]
-  std::optional<GroundPlane> ground;     ///< a rigid ground plane
+  Material material{};
+  std::vector<DirichletSpec> dirichlet{};  ///< fixed and prescribed groups
+  std::vector<RegionLoad> loads{};         ///< total forces on regions
+  Vector3d gravity = Vector3d::Zero();     ///< [m/s²]
+  std::optional<GroundPlane> ground{};     ///< a rigid ground plane
   /// Rigid obstacles (energy/contact_term.hpp): the boundary vertices (unless
   /// SimulationOptions::boundary_contact_points is false) and a driver's further contact points
   /// (SimulationOptions::contact_points) contact them through a barrier in implicit and static
   /// steps, the DOF vertices through a projection in explicit steps.
-  std::vector<Obstacle> obstacles;
+  std::vector<Obstacle> obstacles{};
 };
 
 }  // namespace strata
