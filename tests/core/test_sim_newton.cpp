@@ -47,6 +47,19 @@ struct Cantilever : testing::BoxProblem {
       results.push_back(solver.solve(static_cast<double>(k) / load_steps, q));
     return results;
   }
+
+  /// Minimises the static energy at full load (elastic plus external work) from rest into `q`,
+  /// with `settings` (its rest positions set here).
+  NewtonResult minimize(NewtonSettings settings, VectorXd& q) const {
+    EnergySum energy(embedded->stiffness_pattern());
+    energy.emplace<ElasticTerm>(*embedded);
+    energy.emplace<ExternalWorkTerm>(external);
+    const DofReduction reduction(embedded->stiffness_pattern(), constrained);
+    SpdSolver solver(LinearSolverKind::cholmod);
+    settings.rest_positions = &model->rest_positions();
+    q = model->rest_positions();
+    return newton_minimize(energy, reduction, solver, settings, q);
+  }
 };
 
 double tip_deflection(const Cantilever& c, const VectorXd& q) {
@@ -105,17 +118,11 @@ TEST(Newton, UnreachableResidualConvergesOnTheIncrement) {
   c.solve(1, {}, q_reference);
   // The static energy at full load, minimised with a residual target of zero: only the increment
   // (or a stall at round-off) can end the solve.
-  EnergySum energy(c.embedded->stiffness_pattern());
-  energy.emplace<ElasticTerm>(*c.embedded);
-  energy.emplace<ExternalWorkTerm>(c.external);
-  const DofReduction reduction(c.embedded->stiffness_pattern(), c.constrained);
-  SpdSolver solver(LinearSolverKind::cholmod);
   NewtonSettings settings;
   settings.tolerance = 0.0;
   settings.residual_floor = 0.0;
-  settings.rest_positions = &c.model->rest_positions();
-  VectorXd q = c.model->rest_positions();
-  const NewtonResult r = newton_minimize(energy, reduction, solver, settings, q);
+  VectorXd q;
+  const NewtonResult r = c.minimize(settings, q);
   ASSERT_TRUE(r.converged) << "residual " << r.residual;
   EXPECT_NE(r.criterion, NewtonCriterion::residual);
   EXPECT_LE(r.iterations, 15);
@@ -203,23 +210,16 @@ class StalledGradientTerm final : public EnergyTerm {
 
 TEST(Newton, ASolveStoppedByItsIterationLimitSaysSo) {
   const Cantilever c;
-  EnergySum energy(c.embedded->stiffness_pattern());
-  energy.emplace<ElasticTerm>(*c.embedded);
-  energy.emplace<ExternalWorkTerm>(c.external);
-  const DofReduction reduction(c.embedded->stiffness_pattern(), c.constrained);
-  SpdSolver solver(LinearSolverKind::cholmod);
   NewtonSettings settings;
-  settings.rest_positions = &c.model->rest_positions();
   settings.max_iterations = 1;  // the bending cantilever needs several
-  VectorXd q = c.model->rest_positions();
-  const NewtonResult r = newton_minimize(energy, reduction, solver, settings, q);
+  VectorXd q;
+  const NewtonResult r = c.minimize(settings, q);
   EXPECT_FALSE(r.converged);
   EXPECT_EQ(r.iterations, 1);
   EXPECT_EQ(r.failure, NewtonFailure::iteration_limit);
   EXPECT_EQ(describe(r.failure), "the iteration limit");
   settings.max_iterations = 50;
-  q = c.model->rest_positions();
-  const NewtonResult full = newton_minimize(energy, reduction, solver, settings, q);
+  const NewtonResult full = c.minimize(settings, q);
   EXPECT_TRUE(full.converged);
   EXPECT_GT(full.iterations, 1);
   EXPECT_EQ(full.failure, NewtonFailure::none);
@@ -230,27 +230,20 @@ TEST(Newton, OutOfIterationsWithAResidualARoundOffStallWouldAcceptIsConverged) {
   // iterations: against a force scale its residual is 1e-5 of by then it has stalled (converged,
   // as a stall); against one ten thousand times smaller it has not (the iteration limit).
   const Cantilever c;
-  EnergySum energy(c.embedded->stiffness_pattern());
-  energy.emplace<ElasticTerm>(*c.embedded);
-  energy.emplace<ExternalWorkTerm>(c.external);
-  const DofReduction reduction(c.embedded->stiffness_pattern(), c.constrained);
-  SpdSolver solver(LinearSolverKind::cholmod);
   NewtonSettings settings;
   settings.tolerance = 0.0;
   settings.residual_floor = 0.0;
   settings.increment_tolerance = 0.0;
   settings.step_tolerance = 0.0;
-  settings.rest_positions = &c.model->rest_positions();
   settings.max_iterations = 3;
-  VectorXd q = c.model->rest_positions();
-  const NewtonResult probe = newton_minimize(energy, reduction, solver, settings, q);
+  VectorXd q;
+  const NewtonResult probe = c.minimize(settings, q);
   ASSERT_FALSE(probe.converged);
   ASSERT_EQ(probe.failure, NewtonFailure::iteration_limit);
   ASSERT_GT(probe.residual, 0.0);
   for (const double factor : {2.0, 2e-4}) {
     settings.force_scale = factor * probe.residual / settings.stall_residual_tolerance;
-    q = c.model->rest_positions();
-    const NewtonResult r = newton_minimize(energy, reduction, solver, settings, q);
+    const NewtonResult r = c.minimize(settings, q);
     EXPECT_EQ(r.iterations, 3);
     EXPECT_DOUBLE_EQ(r.residual, probe.residual);
     if (factor > 1.0) {

@@ -111,27 +111,27 @@ class SceneSimulation {
             h.mode == HierarchyMode::full ? "hierarchy.levels" : "hierarchy.level");
       }
       std::vector<Obstacle> obstacles = build_obstacles(scene, mesh);
+      const bool has_obstacles = !obstacles.empty();
+      ProblemSpec problem{.material = scene.material,
+                          .dirichlet = scene.dirichlet_groups(),
+                          .loads = scene.forces,
+                          .gravity = scene.gravity,
+                          .obstacles = std::move(obstacles)};
       if (scene.hierarchy) {
         // The fine surface's vertices as material points of the tree (bound to the coarse mesh,
         // the tree's roots): each cut embeds them in its active tets.
         std::vector<RootPoint> contact_surface;
-        if (!obstacles.empty() && binding != nullptr)
+        if (has_obstacles && binding != nullptr)
           for (Index i = 0; i < binding->tets.size(); ++i)
             contact_surface.push_back({binding->tets[i], surface_rest->row(i).transpose()});
-        auto adaptive =
-            std::make_unique<AdaptiveSimulation>(mesh, *scene.hierarchy,
-                                                 ProblemSpec{.material = scene.material,
-                                                             .dirichlet = scene.dirichlet_groups(),
-                                                             .loads = scene.forces,
-                                                             .gravity = scene.gravity,
-                                                             .obstacles = std::move(obstacles)},
-                                                 scene.solver, std::move(contact_surface));
+        auto adaptive = std::make_unique<AdaptiveSimulation>(
+            mesh, *scene.hierarchy, std::move(problem), scene.solver, std::move(contact_surface));
         m_adaptive = adaptive.get();
         m_run = std::move(adaptive);
       } else {
         SimulationOptions options;
         options.surface_springs = scene.surface_springs;
-        if (!obstacles.empty() && binding != nullptr) {
+        if (has_obstacles && binding != nullptr) {
           // The fine surface collides too: its vertices are contact points through their binding.
           for (Index i = 0; i < binding->corners.rows(); ++i)
             options.contact_points.push_back(
@@ -140,13 +140,8 @@ class SceneSimulation {
                  {binding->barycentric(i, 0), binding->barycentric(i, 1),
                   binding->barycentric(i, 2), binding->barycentric(i, 3)}});
         }
-        m_run = std::make_unique<Simulation>(mesh,
-                                             ProblemSpec{.material = scene.material,
-                                                         .dirichlet = scene.dirichlet_groups(),
-                                                         .loads = scene.forces,
-                                                         .gravity = scene.gravity,
-                                                         .obstacles = std::move(obstacles)},
-                                             scene.solver, std::move(options));
+        m_run = std::make_unique<Simulation>(mesh, std::move(problem), scene.solver,
+                                             std::move(options));
       }
     } catch (const InputError& error) {
       throw InputError(scene.file.string() + ": " + error.what());
