@@ -55,8 +55,7 @@ void implicit_step_benchmark(benchmark::State& state, MeshSize size, MaterialMod
                         .stiffness_damping = mat.stiffness_damping,
                         .ramp_time = 1.0,
                         .diagonal = (hi - lo).norm()};
-  ImplicitEuler stepper(problem, solver,
-                        {newton_iteration_limit(settings, false), settings.newton_tolerance});
+  ImplicitEuler stepper(problem, solver, newton_controls(settings, false));
 
   const VectorXd rest = model.rest_positions();
   VectorXd x = rest;

@@ -93,8 +93,7 @@ void tree_step_benchmark(benchmark::State& state, int level, LinearSolverKind so
                         .nested_spaces = &box.spaces};
   SolverSettings settings;
   settings.dt = dt;
-  ImplicitEuler stepper(problem, solver,
-                        {newton_iteration_limit(settings, false), settings.newton_tolerance});
+  ImplicitEuler stepper(problem, solver, newton_controls(settings, false));
 
   const VectorXd rest = model.rest_positions();
   VectorXd x = rest;

@@ -260,12 +260,12 @@ void AdaptiveSimulation::initial_adaptation() {
   statics.mode = SimulationMode::static_equilibrium;
   statics.load_steps = 1;
   // Only the pattern of the response matters here, not its last digits.
-  statics.newton_tolerance = std::max(statics.newton_tolerance, 1e-6);
+  statics.newton.tolerance = std::max(statics.newton.tolerance, 1e-6);
   // Each pass solves its cut once: no later solve reuses a Cholesky factor, the case for which
   // `automatic` keeps CHOLMOD below kMultigridMinDofs. On a cut with coarser levels the tree's
   // multigrid was as fast at 225 free DOFs and 1.8–2.4 times faster at 1.2k–6.5k (README, "Error
   // control"); a cut without them keeps the automatic choice.
-  const bool automatic_solver = statics.linear_solver == LinearSolverKind::automatic;
+  const bool automatic_solver = statics.newton.linear_solver == LinearSolverKind::automatic;
   bool changed = false;  // m_constrained and m_mesh_external are ahead of m_simulation
   // Each pass after the first starts Newton from the previous pass's response carried to the
   // refined cut through the tree (the previous flat mesh and its deformed positions); with
@@ -291,7 +291,7 @@ void AdaptiveSimulation::initial_adaptation() {
        ++pass) {
     SimulationOptions options = flatten(0);
     if (automatic_solver)
-      statics.linear_solver =
+      statics.newton.linear_solver =
           options.nested_spaces.empty() ? LinearSolverKind::automatic : LinearSolverKind::multigrid;
     m_mesh_external = peak_loads(options);
     options.extra_mesh_forces = m_mesh_external;

@@ -208,8 +208,8 @@ TEST(SceneParser, PlasticityAndLoadHistories) {
   EXPECT_EQ(parsed.forces[0].amplitude.value(2.0), 0.0);
   ASSERT_EQ(parsed.prescribed.size(), 1u);
   EXPECT_EQ(parsed.prescribed[0].amplitude.value(0.0), 1.0);  // constant beyond the ends
-  EXPECT_EQ(parsed.solver.max_plastic_passes, 7);
-  EXPECT_EQ(parsed.solver.plastic_tolerance, 1e-4);
+  EXPECT_EQ(parsed.solver.plasticity.max_passes, 7);
+  EXPECT_EQ(parsed.solver.plasticity.tolerance, 1e-4);
   EXPECT_FALSE(parse_scene(minimal_scene(), "scene.json").material.plasticity.has_value());
 }
 

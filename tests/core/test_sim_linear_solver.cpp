@@ -31,7 +31,7 @@ ColumnRun solve_column(SimulationMode mode, LinearSolverKind solver,
   SolverSettings settings;
   settings.mode = mode;
   settings.integrator = Integrator::implicit_euler;
-  settings.linear_solver = solver;
+  settings.newton.linear_solver = solver;
   settings.dt = 0.01;
   settings.duration = 0.1;
   settings.load_steps = 2;

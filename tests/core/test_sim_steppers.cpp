@@ -72,8 +72,8 @@ TEST(Steppers, DynamicSteppersFollowFreeFall) {
 TEST(Steppers, FailedImplicitStepLeavesTheStartState) {
   const FreeBox box;
   SolverSettings settings;
-  settings.max_newton_iterations = 1;
-  settings.newton_tolerance = 1e-300;  // one iteration cannot reach it
+  settings.newton.max_iterations = 1;
+  settings.newton.tolerance = 1e-300;  // one iteration cannot reach it
   std::unique_ptr<TimeStepper> stepper = find_stepper(settings).make(*box.problem, settings);
   VectorXd q = box.model->rest_positions();
   q[0] += 0.01;  // a deformed start, so the step has work to do

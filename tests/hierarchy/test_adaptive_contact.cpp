@@ -307,7 +307,7 @@ struct SunkBlock {
     SolverSettings settings;
     settings.dt = 1e-3;
     settings.duration = 1.0;
-    settings.contact_distance = 1e-3;
+    settings.contact.distance = 1e-3;
     auto sim = std::make_unique<Simulation>(
         mesh,
         ProblemSpec{.material = rubber(),

@@ -254,11 +254,11 @@ struct ChangingSlabRun {
   SolverSettings solver;
   HierarchySettings hierarchy;
 };
-ChangingSlabRun changing_slab_run(int start_level,
-                                  LinearSolverKind linear_solver = SolverSettings().linear_solver) {
+ChangingSlabRun changing_slab_run(
+    int start_level, LinearSolverKind linear_solver = SolverSettings().newton.linear_solver) {
   ChangingSlabRun run;
   run.solver.integrator = Integrator::implicit_euler;
-  run.solver.linear_solver = linear_solver;
+  run.solver.newton.linear_solver = linear_solver;
   run.solver.dt = 2e-3;
   run.solver.duration = 0.04;
   run.hierarchy = hierarchy(2, HierarchyMode::adaptive, start_level);

@@ -166,8 +166,9 @@ TEST(AdaptiveTolerance, InStepRefinementRedoesStepsWithoutAnInitialAdaptation) {
   ToleranceReport one_pass;
   plate.run(h, &one_pass);
   EXPECT_GT(one_pass.steps_out_of_passes, 0);
-  if (one_pass.full_resolution_step < 0)  // every redo was its step's only pass
+  if (one_pass.full_resolution_step < 0) {  // every redo was its step's only pass
     EXPECT_EQ(one_pass.steps_out_of_passes, one_pass.redone_steps);
+  }
 }
 
 TEST(AdaptiveTolerance, InStepRefinementAimsBelowTheToleranceSoACreepingEstimateRedoesLess) {

@@ -650,7 +650,7 @@ TEST(CutMultigrid, RunsMatchCholmod) {
       solver.load_steps = 3;
       SCOPED_TRACE(std::string(dynamic ? "dynamic " : "static ") + to_string(mode));
       auto run = [&](LinearSolverKind kind) {
-        solver.linear_solver = kind;
+        solver.newton.linear_solver = kind;
         AdaptiveSimulation sim(
             coarse, hierarchy,
             {.material = rubber, .dirichlet = {clamp}, .gravity = Vector3d(0.0, 0.0, -9.81)},

@@ -115,7 +115,7 @@ struct BarRun {
     material.plasticity = Plasticity{kYield, 0.05 * kE};
     settings.mode = SimulationMode::static_equilibrium;
     settings.load_steps = 8;
-    settings.plastic_tolerance = 1e-6;
+    settings.plasticity.tolerance = 1e-6;
   }
   std::unique_ptr<Simulation> make(const FlatTreeMesh& flat, long first_step = 0,
                                    PlasticState state = {}) const {

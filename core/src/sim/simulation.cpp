@@ -121,7 +121,7 @@ Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& 
   if (m_ground)
     m_ground_stiffness =
         ground_penalty_stiffness(m_material.youngs_modulus, m_embedded->mean_edge_length(),
-                                 m_settings.contact_stiffness_factor);
+                                 m_settings.contact.ground_stiffness_factor);
 
   m_first_step = options.first_step;
   m_steps = m_first_step;
@@ -177,14 +177,15 @@ Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& 
     m_contact_points = embed_points(mesh_points);
     m_mesh_contact_points = std::move(mesh_points);
     contact.distance =
-        m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * m_diagonal;
+        m_settings.contact.distance > 0.0 ? m_settings.contact.distance : 1e-3 * m_diagonal;
     if (!(options.contact_stiffness >= 0.0) || !std::isfinite(options.contact_stiffness))
       throw InputError("simulation: contact_stiffness must be finite and >= 0");
     contact.stiffness = options.contact_stiffness > 0.0
                             ? options.contact_stiffness
                             : m_material.youngs_modulus * m_embedded->mean_edge_length();
-    contact.friction_slip =
-        m_settings.friction_slip > 0.0 ? m_settings.friction_slip : 1e-3 * contact.distance;
+    contact.friction_slip = m_settings.contact.friction_slip > 0.0
+                                ? m_settings.contact.friction_slip
+                                : 1e-3 * contact.distance;
     m_contact = std::make_unique<ContactTerm>(m_obstacles, m_contact_points, contact);
   }
   m_x = m_embedded->rest_positions();
@@ -442,7 +443,7 @@ void Simulation::update_plastic_state(double t0, double t1, double h, const Vect
   const Plasticity& plasticity = *m_material.plasticity;
   const PlasticState start = m_plastic;
   const double tolerance =
-      m_settings.plastic_tolerance * plasticity.yield_stress / m_material.youngs_modulus;
+      m_settings.plasticity.tolerance * plasticity.yield_stress / m_material.youngs_modulus;
   const Index num_tets = start.num_tets();
   VectorXd used = pack(start);  // the state the last solve used
   VectorXd previous_residual;
@@ -456,7 +457,7 @@ void Simulation::update_plastic_state(double t0, double t1, double h, const Vect
     const VectorXd residual = image - used;
     const double change = num_tets == 0 ? 0.0 : residual.head(num_tets).cwiseAbs().maxCoeff();
     const bool last = m_stepper_traits->is_explicit || change <= tolerance ||
-                      pass >= m_settings.max_plastic_passes;
+                      pass >= m_settings.plasticity.max_passes;
     if (last) {
       if (!(m_stepper_traits->is_explicit || change <= tolerance))
         ++m_newton.plastic_unconverged_steps;

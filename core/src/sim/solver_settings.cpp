@@ -65,8 +65,13 @@ LinearSolverKind linear_solver_from_string(const std::string& name) {
 }
 
 int newton_iteration_limit(const SolverSettings& settings, bool contact) {
-  if (settings.max_newton_iterations > 0) return settings.max_newton_iterations;
+  if (settings.newton.max_iterations > 0) return settings.newton.max_iterations;
   return contact ? 200 : 50;
+}
+
+NewtonControls newton_controls(const SolverSettings& settings, bool contact) {
+  return {newton_iteration_limit(settings, contact), settings.newton.tolerance,
+          settings.newton.exact_hessian};
 }
 
 long planned_steps(const SolverSettings& settings) {
@@ -81,12 +86,12 @@ void validate_solver_settings(const SolverSettings& s, const std::string& where)
   };
   positive(s.dt, "dt");
   positive(s.duration, "duration");
-  positive(s.newton_tolerance, "newton_tolerance");
-  positive(s.contact_stiffness_factor, "contact_stiffness_factor");
-  positive(s.plastic_tolerance, "plastic_tolerance");
-  if (!std::isfinite(s.contact_distance) || s.contact_distance < 0.0)
+  positive(s.newton.tolerance, "newton_tolerance");
+  positive(s.contact.ground_stiffness_factor, "contact_stiffness_factor");
+  positive(s.plasticity.tolerance, "plastic_tolerance");
+  if (!std::isfinite(s.contact.distance) || s.contact.distance < 0.0)
     throw InputError(where + ".contact_distance: must be a finite number >= 0");
-  if (!std::isfinite(s.friction_slip) || s.friction_slip < 0.0)
+  if (!std::isfinite(s.contact.friction_slip) || s.contact.friction_slip < 0.0)
     throw InputError(where + ".friction_slip: must be a finite number >= 0");
   if (!std::isfinite(s.ramp_time) || s.ramp_time < 0.0)
     throw InputError(where + ".ramp_time: must be a finite number >= 0");
@@ -101,9 +106,9 @@ void validate_solver_settings(const SolverSettings& s, const std::string& where)
                   s.duration / s.dt);
     throw InputError(where + text);
   }
-  if (s.max_newton_iterations < 0)
+  if (s.newton.max_iterations < 0)
     throw InputError(where + ".max_newton_iterations: must be >= 0 (0: automatic)");
-  if (s.max_plastic_passes < 1) throw InputError(where + ".max_plastic_passes: must be >= 1");
+  if (s.plasticity.max_passes < 1) throw InputError(where + ".max_plastic_passes: must be >= 1");
 }
 
 }  // namespace strata

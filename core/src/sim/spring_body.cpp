@@ -278,10 +278,10 @@ SpringBodySimulation::SpringBodySimulation(SpringBody body, ProblemSpec problem,
         (m_body.rest.colwise().maxCoeff() - m_body.rest.colwise().minCoeff()).norm();
     const double mean_edge = mean_triangle_edge_length(m_body.rest, m_body.triangles);
     m_contact_settings.distance =
-        m_settings.contact_distance > 0.0 ? m_settings.contact_distance : 1e-3 * diagonal;
+        m_settings.contact.distance > 0.0 ? m_settings.contact.distance : 1e-3 * diagonal;
     m_contact_settings.stiffness = m_material.youngs_modulus * mean_edge;
-    m_contact_settings.friction_slip = m_settings.friction_slip > 0.0
-                                           ? m_settings.friction_slip
+    m_contact_settings.friction_slip = m_settings.contact.friction_slip > 0.0
+                                           ? m_settings.contact.friction_slip
                                            : 1e-3 * m_contact_settings.distance;
     m_surface_points.resize(static_cast<std::size_t>(m_body.num_surface));
     for (Index i = 0; i < m_body.num_surface; ++i)
@@ -404,7 +404,7 @@ bool SpringBodySimulation::try_implicit(double t1, double h) {
   m_body.springs.add_forces(q, f_int);
   NewtonSettings settings;
   settings.max_iterations = newton_iteration_limit(m_settings, m_contact != nullptr);
-  settings.tolerance = m_settings.newton_tolerance;
+  settings.tolerance = m_settings.newton.tolerance;
   settings.force_scale = f_int.norm() + f_ext.norm() + m_mass.cwiseProduct(m_v).norm() / h +
                          mass.cwiseProduct(q - predicted).norm() / (h * h);
   const double size = (m_body.rest.colwise().maxCoeff() - m_body.rest.colwise().minCoeff()).norm();

@@ -277,27 +277,28 @@ SolverSettings parse_solver(const SceneValue& value) {
   if (value.has("load_steps")) solver.load_steps = value.at("load_steps").integer(1);
   if (value.has("linear_solver")) {
     static const std::vector<std::string> kinds = {"cholmod", "cg", "multigrid", "amg", "auto"};
-    solver.linear_solver =
+    solver.newton.linear_solver =
         linear_solver_from_string(kinds[value.at("linear_solver").choice(kinds)]);
   }
   if (value.has("newton_tolerance")) {
-    solver.newton_tolerance = value.at("newton_tolerance").positive();
+    solver.newton.tolerance = value.at("newton_tolerance").positive();
   }
   if (value.has("max_newton_iterations")) {
-    solver.max_newton_iterations = value.at("max_newton_iterations").integer(1);
+    solver.newton.max_iterations = value.at("max_newton_iterations").integer(1);
   }
   if (value.has("hessian"))
-    solver.exact_hessian = value.at("hessian").choice({"projected", "exact_where_pd"}) == 1;
+    solver.newton.exact_hessian = value.at("hessian").choice({"projected", "exact_where_pd"}) == 1;
   if (value.has("max_plastic_passes")) {
-    solver.max_plastic_passes = value.at("max_plastic_passes").integer(1);
+    solver.plasticity.max_passes = value.at("max_plastic_passes").integer(1);
   }
   if (value.has("plastic_tolerance")) {
-    solver.plastic_tolerance = value.at("plastic_tolerance").positive();
+    solver.plasticity.tolerance = value.at("plastic_tolerance").positive();
   }
   if (value.has("contact_distance")) {
-    solver.contact_distance = value.at("contact_distance").positive();
+    solver.contact.distance = value.at("contact_distance").positive();
   }
-  if (value.has("friction_slip")) solver.friction_slip = value.at("friction_slip").positive();
+  if (value.has("friction_slip"))
+    solver.contact.friction_slip = value.at("friction_slip").positive();
   return solver;
 }
 

@@ -612,9 +612,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
     log.flush();
     std::cerr << "strata: warning: " << scene.file.string()
               << ": the plastic state had not settled "
-              << "within solver.max_plastic_passes = " << scene.solver.max_plastic_passes << " at "
-              << counters.plastic_unconverged_steps << " of " << summary.steps
-              << " steps (solver.plastic_tolerance " << scene.solver.plastic_tolerance << ")\n";
+              << "within solver.max_plastic_passes = " << scene.solver.plasticity.max_passes
+              << " at " << counters.plastic_unconverged_steps << " of " << summary.steps
+              << " steps (solver.plastic_tolerance " << scene.solver.plasticity.tolerance << ")\n";
   }
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
       adaptive && (adaptive->settings().mode == HierarchyMode::adaptive ||

@@ -13,9 +13,8 @@ NewtonResult explicit_result() {
 }  // namespace
 
 BackwardEulerStepper::BackwardEulerStepper(const Problem& problem, const SolverSettings& settings)
-    : m_integrator(problem, settings.linear_solver,
-                   {newton_iteration_limit(settings, problem.has_obstacles()),
-                    settings.newton_tolerance, settings.exact_hessian}) {}
+    : m_integrator(problem, settings.newton.linear_solver,
+                   newton_controls(settings, problem.has_obstacles())) {}
 
 NewtonResult BackwardEulerStepper::step(double t0, double, double h, VectorXd& q, VectorXd& v) {
   VectorXd q_step = q, v_step = v;

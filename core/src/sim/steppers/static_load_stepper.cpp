@@ -6,9 +6,8 @@ namespace strata {
 
 StaticLoadStepper::StaticLoadStepper(const Problem& problem, const SolverSettings& settings)
     : m_problem(problem),
-      m_solver(problem, settings.linear_solver,
-               {newton_iteration_limit(settings, problem.has_obstacles()),
-                settings.newton_tolerance, settings.exact_hessian}) {}
+      m_solver(problem, settings.newton.linear_solver,
+               newton_controls(settings, problem.has_obstacles())) {}
 
 NewtonResult StaticLoadStepper::step(double, double t1, double, VectorXd& q, VectorXd& v) {
   VectorXd guess = q;

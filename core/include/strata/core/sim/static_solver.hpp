@@ -13,16 +13,9 @@
 #include "strata/core/sim/linear_solver.hpp"
 #include "strata/core/sim/newton_solver.hpp"
 #include "strata/core/sim/problem.hpp"
+#include "strata/core/sim/solver_settings.hpp"
 
 namespace strata {
-
-/// The Newton controls a scene sets (solver.max_newton_iterations, solver.newton_tolerance).
-struct NewtonControls {
-  int max_iterations = 50;
-  double tolerance = 1e-10;
-  /// Exact Hessian where positive definite (else projected); false: always PSD-projected.
-  bool exact_hessian = true;
-};
 
 class StaticSolver {
  public:
