@@ -80,6 +80,7 @@ SimulationCounters add(SimulationCounters a, const SimulationCounters& b) {
   a.multigrid_direct_fallbacks += b.multigrid_direct_fallbacks;
   a.linear_solver = b.linear_solver;
   a.exact_hessian_iterations += b.exact_hessian_iterations;
+  a.shifted_hessian_iterations += b.shifted_hessian_iterations;
   a.projected_hessian_iterations += b.projected_hessian_iterations;
   a.increment_converged_steps += b.increment_converged_steps;
   a.stalled_steps += b.stalled_steps;

@@ -201,6 +201,11 @@ TEST(CliHierarchy, UnmetToleranceWarnsAndIsReported) {
   const CliResult capped = run_strata("run capped.json --quiet", folder.path());
   ASSERT_EQ(capped.exit_code, 0) << capped.err;
   EXPECT_THAT(capped.err, HasSubstr("exceeded hierarchy.tolerance 0.01"));
+  // It names the limits this run has, and only those.
+  EXPECT_THAT(capped.err, HasSubstr("2 decisions on a cut no tet of which may refine "
+                                    "(hierarchy.max_level)"));
+  EXPECT_THAT(capped.err, ::testing::Not(HasSubstr("max_active_elements")));
+  EXPECT_THAT(capped.err, ::testing::Not(HasSubstr("explicit step limit")));
   const json stats = read_json(folder.path() / "out" / "capped" / "stats.json");
   const json& h = stats["hierarchy"];
   EXPECT_EQ(h["indicator"], "recovery");

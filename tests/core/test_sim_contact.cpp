@@ -407,6 +407,49 @@ TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
     EXPECT_GE(sim.positions()[i], -1e-12);
 }
 
+TEST(ContactScenes, ExplicitStepsReportTheProjectedContactsAndTheirForces) {
+  // The cube resting on the ground under gravity, symplectic Euler, damped to rest: each step's
+  // projection is its contact. The 3 × 3 bottom vertices are in contact, the depth they reached
+  // before the projection is reported, and the contact forces (the momentum the projection
+  // changes, M Δv / h) carry the cube's weight, averaged over the last 10 ms.
+  SolverSettings settings;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.dt = 2e-5;
+  settings.duration = 0.1;
+  Material material = rubber();
+  material.mass_damping = 100.0;
+  Simulation sim(cube(),
+                 {.material = material,
+                  .gravity = Vector3d(0, 0, -9.81),
+                  .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
+                 settings);
+  const double weight = 9.81 * sim.vertex_mass().sum();
+  double impulse = 0.0, elapsed = 0.0;
+  while (!sim.finished()) {
+    sim.advance();
+    if (sim.time() <= settings.duration - 0.01 + 1e-12) continue;
+    const VectorXd f = sim.contact_forces();
+    double fz = 0.0;
+    for (Index v = 0; v < f.size() / 3; ++v)
+      fz += f[3 * v + 2];
+    impulse += fz * settings.dt;
+    elapsed += settings.dt;
+  }
+  EXPECT_NEAR(impulse / elapsed, weight, 0.01 * weight);
+  EXPECT_EQ(sim.contact_counts().size(), static_cast<std::size_t>(sim.step_count()));
+  EXPECT_EQ(sim.contact_counts().back(), 9);
+  // Each step the bottom sinks by about g h² before it is projected back.
+  EXPECT_GT(sim.max_penetration(), 0.0);
+  EXPECT_LT(sim.max_penetration(), 1e-6);
+  // The criteria of an adaptive run read them on the mesh vertices: the bottom ones.
+  const VectorXd on_mesh = sim.mesh_contact_forces();
+  for (Index v = 0; v < sim.mesh().vertices.rows(); ++v)
+    if (sim.mesh().vertices(v, 2) > 1e-9) {
+      EXPECT_TRUE(on_mesh.segment<3>(3 * v).isZero());
+    }
+  EXPECT_NEAR(on_mesh.sum(), sim.contact_forces().sum(), 1e-12 * weight);
+}
+
 TEST(ContactScenes, AnObstacleThatReachesAHeldPointIsNamedInTheError) {
   // A wall moving at 0.1 m/s towards the cube's x = 0.1 face, 0.3 mm away, while the cube's
   // bottom face is clamped: within a few 4 ms steps the wall passes the clamped vertices on that

@@ -214,6 +214,19 @@ std::shared_ptr<MultigridCoarseLevels> SpdSolver::release_coarse_levels() {
   return levels;
 }
 
+bool SpdSolver::solve_if_definite(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
+  m_probing = true;
+  bool solved = false;
+  try {
+    solved = solve(A, b, x);
+  } catch (...) {
+    m_probing = false;
+    throw;
+  }
+  m_probing = false;
+  return solved;
+}
+
 bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
   if (A.rows() == 0) {
     x.resize(0);
@@ -323,6 +336,7 @@ bool SpdSolver::solve_multigrid(const SparseMatrixd& A, ConstRef<VectorXd> b, Ve
   // projects) and multigrid stays for the next matrix.
   auto direct = [&] {
     m_multigrid_stale = true;
+    if (m_probing) return false;
     ++m_direct_fallbacks;
     if (!solve_cholmod(A, b, x)) return false;
     m_kind = LinearSolverKind::cholmod;

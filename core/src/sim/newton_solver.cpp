@@ -31,25 +31,64 @@ double displacement_scale(const NewtonSettings& settings, const VectorXd& q) {
   return std::max(scale, settings.step_tolerance);
 }
 
-/// Chooses the Hessian of each iteration: exact first, projected where the exact one is not
-/// positive definite, with an exponential back-off before the exact one is tried again.
+/// Chooses the Hessian of each iteration: the exact one, or where it is not positive definite the
+/// exact one shifted (solve_shifted_exact); where no shift makes it so, the PSD-projected one, with
+/// an exponential back-off before the exact one is tried again. The next iteration starts at a
+/// quarter of the shift that worked (as Levenberg–Marquardt's damping falls near a minimum), and at
+/// the exact Hessian itself once that is below the first shift.
 class HessianChoice {
  public:
   explicit HessianChoice(bool exact_allowed) : m_exact_allowed(exact_allowed) {}
   bool try_exact() const { return m_exact_allowed && m_skip == 0; }
+  double first_shift() const { return m_shift; }
+  void exact_solved(double shift) {
+    m_shift = shift / kShiftFactor >= kFirstShift ? shift / kShiftFactor : 0.0;
+  }
   void exact_failed() {
     m_backoff = std::max(1, 2 * m_backoff);
     m_skip = m_backoff;
+    m_shift = 0.0;
   }
   void iteration_done() {
     if (m_skip > 0) --m_skip;
   }
 
+  /// The shifts tried, relative to the Hessian's largest diagonal entry: 10⁻⁴ · 4ᵏ up to 1.
+  static constexpr double kFirstShift = 1e-4;
+  static constexpr double kShiftFactor = 4.0;
+  static constexpr double kLastShift = 1.0;
+
  private:
   bool m_exact_allowed;
   int m_backoff = 0;
   int m_skip = 0;
+  double m_shift = 0.0;
 };
+
+/// Solves (H + s·d·I) Δ = rhs with H the exact Hessian and d its largest diagonal entry, for the
+/// first s of 0, 10⁻⁴, 4 · 10⁻⁴, 1.6 · 10⁻³, …, up to 1 (from `first` on) whose solve succeeds and
+/// descends (a solve answered without a factorisation, CG on a previous factor, does not prove the
+/// matrix positive definite). Returns that s, or −1. Past an instability (a compressed body about
+/// to fold, a symmetric path past a bifurcation) H has a few negative eigenvalues: the smallest
+/// shift that makes it positive definite keeps its curvature everywhere else and leads along the
+/// unstable directions, where the per-element projection discards the curvature of every element
+/// compressed beyond its own stability and converges linearly at best.
+double solve_shifted_exact(SpdSolver& solver, const SparseMatrixd& H, const VectorXd& rhs,
+                           VectorXd& step, double first) {
+  if (first == 0.0 && solver.solve(H, rhs, step) && rhs.dot(step) > 0.0) return 0.0;
+  double max_diagonal = 0.0;
+  for (Index i = 0; i < H.rows(); ++i)
+    max_diagonal = std::max(max_diagonal, H.coeff(i, i));
+  if (!(max_diagonal > 0.0) || !std::isfinite(max_diagonal)) return -1.0;
+  double shift = std::max(first, HessianChoice::kFirstShift);
+  for (; shift <= HessianChoice::kLastShift; shift *= HessianChoice::kShiftFactor) {
+    SparseMatrixd shifted = H;
+    for (Index i = 0; i < H.rows(); ++i)
+      shifted.coeffRef(i, i) += shift * max_diagonal;
+    if (solver.solve_if_definite(shifted, rhs, step) && rhs.dot(step) > 0.0) return shift;
+  }
+  return -1.0;
+}
 
 /// Relative tolerance of each iterative linear solve (inexact Newton, Eisenstat & Walker 1996,
 /// choice 2 with γ = 0.9, α = 2): η_k = γ (‖g_k‖ / ‖g_{k−1}‖)², at most kMaxForcing (and
@@ -167,13 +206,15 @@ NewtonResult newton_minimize(const EnergySum& objective, const DofReduction& red
     if (exact) {
       objective.hessian(x, hessian, false);
       reduction.restrict_matrix(hessian, reduced_hessian);
-      // A solve answered without a factorisation (CG on a previous factor) does not prove the
-      // matrix positive definite: the step must also descend.
-      solved = solver.solve(reduced_hessian, -g, step) && g.dot(step) < 0.0;
-      if (solved)
-        ++result.exact_hessian_iterations;
-      else
+      const double shift =
+          solve_shifted_exact(solver, reduced_hessian, -g, step, choice.first_shift());
+      solved = shift >= 0.0;
+      if (!solved) {
         choice.exact_failed();
+      } else {
+        choice.exact_solved(shift);
+        ++(shift > 0.0 ? result.shifted_hessian_iterations : result.exact_hessian_iterations);
+      }
     }
     if (!solved) {
       objective.hessian(x, hessian, true);

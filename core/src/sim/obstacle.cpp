@@ -30,8 +30,9 @@ void validate_obstacle(const Obstacle& obstacle) {
 }
 
 Index project_obstacle_contact(const std::vector<Obstacle>& obstacles, double t, VectorXd& x,
-                               VectorXd& v, const std::vector<char>& skip) {
+                               VectorXd& v, const std::vector<char>& skip, double* deepest) {
   Index contacts = 0;
+  if (deepest != nullptr) *deepest = 0.0;
   for (const Obstacle& obstacle : obstacles) {
     for (Index i = 0; i < x.size() / 3; ++i) {
       if (!skip.empty() && skip[3 * i]) continue;
@@ -39,6 +40,7 @@ Index project_obstacle_contact(const std::vector<Obstacle>& obstacles, double t,
       const double phi = obstacle.distance_at(x.segment<3>(3 * i), t, gradient);
       if (!(phi < 0.0) || gradient.norm() == 0.0) continue;
       ++contacts;
+      if (deepest != nullptr) *deepest = std::max(*deepest, -phi);
       const Vector3d n = gradient.normalized();
       x.segment<3>(3 * i) -= phi * n;
       v.segment<3>(3 * i) =

@@ -307,8 +307,12 @@ void Simulation::advance() {
   record_newton(result);
   if (!result.converged) throw_newton_failure(std::string(m_stepper_traits->name), result);
   if (m_ground && !is_static()) project_ground_contact(*m_ground, m_x, m_v, m_constrained);
-  if (has_obstacles() && m_stepper_traits->is_explicit)
-    project_obstacle_contact(m_obstacles, t1, m_x, m_v, m_constrained);
+  if (has_obstacles() && m_stepper_traits->is_explicit) {
+    const VectorXd v_before = m_v;
+    m_projected_contacts =
+        project_obstacle_contact(m_obstacles, t1, m_x, m_v, m_constrained, &m_projection_depth);
+    m_projection_forces = m_dof_mass.cwiseProduct(m_v - v_before) / h;
+  }
   update_mesh_state();
   if (is_plastic()) update_plastic_state(t0, t1, h, q_start, v_start);
   if (has_obstacles()) record_contact(q_start, is_static() ? 0.0 : t0, is_static() ? 0.0 : t1);
@@ -352,6 +356,13 @@ std::vector<ContactPoint> Simulation::embed_points(const std::vector<ContactPoin
 
 void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {
   m_contact->set_step(q_start, t0, t1);
+  if (m_stepper_traits->is_explicit) {
+    // The projection has moved every vertex out: what it found is the step's contact.
+    m_last_penetration = m_projection_depth;
+    m_max_penetration = std::max(m_max_penetration, m_last_penetration);
+    m_contact_counts.push_back(m_projected_contacts);
+    return;
+  }
   m_last_penetration = -m_contact->min_distance(m_x);
   m_max_penetration = std::max(m_max_penetration, m_last_penetration);
   VectorXd unused = VectorXd::Zero(m_x.size());
@@ -361,6 +372,13 @@ void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {
 VectorXd Simulation::mesh_contact_forces() const {
   VectorXd f = VectorXd::Zero(3 * m_mesh.vertices.rows());
   if (!m_contact) return f;
+  if (m_stepper_traits->is_explicit) {
+    const VectorXd on_dofs = contact_forces();
+    for (Index q = 0; q < m_embedded->num_dof_vertices(); ++q)
+      f.segment<3>(3 * Index(m_embedded->is_identity() ? q : m_embedded->dof_vertices()[q])) =
+          on_dofs.segment<3>(3 * q);
+    return f;
+  }
   const std::vector<Vector3d> point_forces = m_contact->point_forces(m_x, false);
   for (size_t p = 0; p < point_forces.size(); ++p) {
     if (point_forces[p].isZero()) continue;
@@ -391,6 +409,9 @@ double Simulation::push_out_of_obstacles(double depth, double to_depth) {
 }
 
 VectorXd Simulation::contact_forces() const {
+  if (m_contact && m_stepper_traits->is_explicit)
+    return m_projection_forces.size() == m_x.size() ? m_projection_forces
+                                                    : VectorXd::Zero(m_x.size());
   VectorXd gradient = VectorXd::Zero(m_x.size());
   if (m_contact) m_contact->add_gradient(m_x, gradient);
   return -gradient;
@@ -647,6 +668,7 @@ VectorXd Simulation::current_external_forces() const {
 void Simulation::record_newton(const NewtonResult& result) {
   m_newton.newton_iterations += result.iterations;
   m_newton.exact_hessian_iterations += result.exact_hessian_iterations;
+  m_newton.shifted_hessian_iterations += result.shifted_hessian_iterations;
   m_newton.projected_hessian_iterations += result.projected_hessian_iterations;
   if (!result.converged) return;
   if (result.criterion == NewtonCriterion::increment) ++m_newton.increment_converged_steps;

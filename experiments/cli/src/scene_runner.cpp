@@ -286,6 +286,7 @@ nlohmann::json stats_json(const Scene& scene, const PreparedMesh& prepared,
   stats["element_evaluations"] = counters.element_evaluations;
   stats["factorizations"] = counters.factorizations;
   stats["newton"] = {{"exact_hessian_iterations", counters.exact_hessian_iterations},
+                     {"shifted_hessian_iterations", counters.shifted_hessian_iterations},
                      {"projected_hessian_iterations", counters.projected_hessian_iterations},
                      {"increment_converged_steps", counters.increment_converged_steps},
                      {"stalled_steps", counters.stalled_steps},
@@ -631,16 +632,39 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                   << ": it does not capture this scene (precompute it with these loads, or at a "
                      "tighter --tolerance)\n";
       } else {
-        std::cerr << "; " << report.refused_refinements
-                  << " refinements refused by max_level, max_active_elements, the explicit step "
-                     "limit or hysteresis";
-        if (report.steps_unrefinable > 0)
-          std::cerr << "; " << report.steps_unrefinable
-                    << " decisions on a cut no tet of which may refine (max_level or the explicit "
-                       "step limit)";
+        // Only the limits this run has can have refused a refinement.
+        const HierarchySettings& h = adaptive->settings();
+        std::vector<std::string> limits;
+        if (h.criteria.max_level >= 0 && h.criteria.max_level < h.levels)
+          limits.push_back("hierarchy.max_level");
+        if (h.criteria.max_active_elements > 0) limits.push_back("hierarchy.max_active_elements");
+        if (is_explicit(scene.solver)) limits.push_back("the explicit step limit");
+        if (h.criteria.min_steps_between_changes > 0)
+          limits.push_back("hysteresis (hierarchy.min_steps_between_changes)");
+        const auto either = [&](const std::vector<std::string>& names) {
+          std::string text;
+          for (std::size_t k = 0; k < names.size(); ++k)
+            text += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
+          return text;
+        };
+        const auto count = [](long n, const char* one, const char* many) {
+          return std::to_string(n) + " " + (n == 1 ? one : many);
+        };
+        if (report.refused_refinements > 0 && !limits.empty())
+          std::cerr << "; " << count(report.refused_refinements, "refusal", "refusals")
+                    << " to refine (a tet refused at several passes counts at each) by "
+                    << either(limits);
+        if (report.steps_unrefinable > 0) {
+          std::vector<std::string> hard;
+          for (const std::string& name : limits)
+            if (name.rfind("hysteresis", 0) != 0) hard.push_back(name);
+          std::cerr << "; " << count(report.steps_unrefinable, "decision", "decisions")
+                    << " on a cut no tet of which may refine"
+                    << (hard.empty() ? std::string() : " (" + either(hard) + ")");
+        }
         if (report.steps_out_of_passes > 0)
-          std::cerr << "; " << report.steps_out_of_passes << " steps still refining after all "
-                    << adaptive->settings().max_passes << " hierarchy.max_passes";
+          std::cerr << "; " << count(report.steps_out_of_passes, "step", "steps")
+                    << " still refining after all " << h.max_passes << " hierarchy.max_passes";
         std::cerr << ")\n";
       }
     }

@@ -57,6 +57,10 @@ class SpdSolver {
   /// the same between calls (a change of size or non-zero count triggers a new analysis). Returns
   /// false if A is not numerically positive definite (CHOLMOD) or CG did not converge.
   bool solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
+  /// The same, for a system that may be indefinite (Newton's shifted Hessians): where multigrid
+  /// does not converge it returns false instead of turning to CHOLMOD (which would factorise,
+  /// and take every later solve, only for a matrix that turned out positive definite).
+  bool solve_if_definite(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x);
 
   /// Resolves `automatic` and `multigrid` for a system with these free DOFs (ascending indices
   /// into 3 · spaces->num_fine_vertices()) and, when multigrid is chosen, builds its transfers.
@@ -144,6 +148,7 @@ class SpdSolver {
   Index m_multigrid_rows = -1;
   Index m_multigrid_nonzeros = -1;
   long m_direct_fallbacks = 0;
+  bool m_probing = false;  ///< in solve_if_definite: no direct fallback
   long m_multigrid_setups = 0;
   long m_carried_setups = 0;
   double m_multigrid_setup_seconds = 0.0;

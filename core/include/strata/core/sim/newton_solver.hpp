@@ -5,10 +5,13 @@
 /// potential) and static equilibrium (total potential energy).
 ///
 /// Hessian: the exact Hessian where it is positive definite — tried first, so Newton converges
-/// quadratically near a stable equilibrium — and the PSD-projected one (per element) where the
-/// exact factorisation fails; after a failure the exact Hessian is skipped for 1, 2, 4, …
-/// iterations before it is tried again. Plain CG (incomplete Cholesky) uses the projected Hessian
-/// only; multigrid-PCG tries the exact one and refuses it on negative curvature.
+/// quadratically near a stable equilibrium; where it is not (past an instability: a compressed
+/// body folding, a path past a bifurcation), the exact Hessian plus s·d·I, d its largest diagonal
+/// entry, for the first s of 10⁻⁴ · 4ᵏ up to 1 that makes it positive definite (the next
+/// iteration starts at s/4); where none does, the PSD-projected one (per element), after which
+/// the exact Hessian is skipped for 1, 2, 4, … iterations before it is tried again. Plain CG
+/// (incomplete Cholesky) uses the projected Hessian only; multigrid-PCG tries the exact one and
+/// refuses it on negative curvature.
 ///
 /// Inexact Newton: the iterative linear solves (CG on a previous Cholesky factor, multigrid-PCG)
 /// stop at a relative residual η_k that follows the Newton residual (Eisenstat–Walker; at most
@@ -81,6 +84,7 @@ struct NewtonResult {
   NewtonCriterion criterion = NewtonCriterion::none;
   int iterations = 0;
   int exact_hessian_iterations = 0;             ///< iterations solved with the exact Hessian
+  int shifted_hessian_iterations = 0;           ///< … with the exact one plus a multiple of I
   int projected_hessian_iterations = 0;         ///< … with the PSD-projected one
   double residual = 0.0;                        ///< final ‖g_free‖ [N]
   double residual_target = 0.0;                 ///< the residual criterion's bound [N]

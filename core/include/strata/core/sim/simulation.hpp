@@ -130,6 +130,7 @@ struct SimulationCounters {
   /// current one); cholmod for explicit runs.
   LinearSolverKind linear_solver = LinearSolverKind::cholmod;
   long exact_hessian_iterations = 0;      ///< Newton iterations on the exact Hessian
+  long shifted_hessian_iterations = 0;    ///< … on the exact Hessian plus a multiple of I
   long projected_hessian_iterations = 0;  ///< … on the PSD-projected Hessian
   /// Newton solves (time or load steps) that converged on the increment, and that stopped at a
   /// residual stalled (newton_solver.hpp); both are converged.
@@ -241,7 +242,10 @@ class Simulation final : public SimulationRun {
   /// Obstacle contact: the settings (tolerance d̂, barrier stiffness κ = E × mean edge length,
   /// friction slip), the largest depth of a contact point inside an obstacle after any step so
   /// far [m], the point–obstacle pairs in contact after each step, and the contact forces the
-  /// obstacles exert now (3·#Q [N], normal and friction).
+  /// obstacles exert now (3·#Q [N], normal and friction). Explicit integrators, which project
+  /// the DOF vertices out of the obstacles after each step, report the vertices projected in it,
+  /// the depth the deepest had reached, and as contact forces the momentum the projection
+  /// changed over the step, M Δv / h.
   bool has_obstacles() const { return !m_obstacles.empty(); }
   const ContactSettings& contact_settings() const;
   double max_penetration() const { return m_max_penetration; }
@@ -255,7 +259,8 @@ class Simulation final : public SimulationRun {
   /// none is inside; 0 before the first step).
   double last_penetration() const { return m_last_penetration; }
   VectorXd contact_forces() const;
-  /// The barrier's (normal) contact forces at the current state on the mesh vertices, 3·#V [N]:
+  /// The barrier's (normal) contact forces at the current state on the mesh vertices, 3·#V [N]
+  /// (explicit integrators: the projection's, contact_forces(), at the DOF vertices):
   /// each contact point's force spread over its mesh vertices by its weights (hanging vertices
   /// keep their share; a driver reads them as loads). Zero without obstacles.
   VectorXd mesh_contact_forces() const;
@@ -343,6 +348,11 @@ class Simulation final : public SimulationRun {
   double m_max_penetration = 0.0;
   double m_last_penetration = 0.0;
   long m_contact_step = -1;  ///< step index of the last contact record
+  /// Explicit integrators: the last step's projection out of the obstacles, its contacts, the
+  /// depth the deepest vertex had reached [m] and M Δv / h (3·#Q [N]).
+  Index m_projected_contacts = 0;
+  double m_projection_depth = 0.0;
+  VectorXd m_projection_forces;
   std::vector<Index> m_contact_counts;
   void record_contact(const VectorXd& q_start, double t0, double t1);
   SimulationCounters m_newton;  ///< Newton and plasticity fields only
