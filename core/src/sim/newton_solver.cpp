@@ -53,7 +53,7 @@ class HessianChoice {
     if (m_skip > 0) --m_skip;
   }
 
-  /// The shifts tried, relative to the Hessian's largest diagonal entry: 10⁻⁴ · 4ᵏ up to 1.
+  /// The shifts tried, relative to the Hessian's largest diagonal entry: 10⁻⁴ · 4ᵏ, and 1 last.
   static constexpr double kFirstShift = 1e-4;
   static constexpr double kShiftFactor = 4.0;
   static constexpr double kLastShift = 1.0;
@@ -66,7 +66,7 @@ class HessianChoice {
 };
 
 /// Solves (H + s·d·I) Δ = rhs with H the exact Hessian and d its largest diagonal entry, for the
-/// first s of 0, 10⁻⁴, 4 · 10⁻⁴, 1.6 · 10⁻³, …, up to 1 (from `first` on) whose solve succeeds and
+/// first s of 0, 10⁻⁴, 4 · 10⁻⁴, 1.6 · 10⁻³, …, 0.41, 1 (from `first` on) whose solve succeeds and
 /// descends (a solve answered without a factorisation, CG on a previous factor, does not prove the
 /// matrix positive definite). Returns that s, or −1. Past an instability (a compressed body about
 /// to fold, a symmetric path past a bifurcation) H has a few negative eigenvalues: the smallest
@@ -80,14 +80,14 @@ double solve_shifted_exact(SpdSolver& solver, const SparseMatrixd& H, const Vect
   for (Index i = 0; i < H.rows(); ++i)
     max_diagonal = std::max(max_diagonal, H.coeff(i, i));
   if (!(max_diagonal > 0.0) || !std::isfinite(max_diagonal)) return -1.0;
-  double shift = std::max(first, HessianChoice::kFirstShift);
-  for (; shift <= HessianChoice::kLastShift; shift *= HessianChoice::kShiftFactor) {
+  for (double shift = std::max(first, HessianChoice::kFirstShift);;
+       shift = std::min(shift * HessianChoice::kShiftFactor, HessianChoice::kLastShift)) {
     SparseMatrixd shifted = H;
     for (Index i = 0; i < H.rows(); ++i)
       shifted.coeffRef(i, i) += shift * max_diagonal;
     if (solver.solve_if_definite(shifted, rhs, step) && rhs.dot(step) > 0.0) return shift;
+    if (shift >= HessianChoice::kLastShift) return -1.0;
   }
-  return -1.0;
 }
 
 /// Relative tolerance of each iterative linear solve (inexact Newton, Eisenstat & Walker 1996,

@@ -268,6 +268,7 @@ void Simulation::set_state(ConstRef<VectorXd> positions, ConstRef<VectorXd> velo
   m_x = positions;
   m_v = is_static() ? VectorXd::Zero(m_v.size()) : VectorXd(velocities);
   m_stepper->reset_history();
+  clear_projection();
   if (is_static()) {
     apply_dirichlet(m_groups, m_embedded->rest_positions(), load_factor(), load_factor(), 0.0, m_x,
                     m_v);
@@ -402,10 +403,17 @@ double Simulation::push_out_of_obstacles(double depth, double to_depth) {
   m_contact->set_step(m_x, t, t);
   const double largest = m_contact->push_out(m_x, m_constrained, depth, to_depth);
   if (largest > 0.0) {
+    clear_projection();
     update_mesh_state();
     m_stepper->reset_history();  // forces kept for the next step were at the old positions
   }
   return largest;
+}
+
+void Simulation::clear_projection() {
+  m_projected_contacts = 0;
+  m_projection_depth = 0.0;
+  m_projection_forces.resize(0);
 }
 
 VectorXd Simulation::contact_forces() const {

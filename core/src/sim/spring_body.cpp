@@ -405,6 +405,7 @@ bool SpringBodySimulation::try_implicit(double t1, double h) {
   NewtonSettings settings;
   settings.max_iterations = newton_iteration_limit(m_settings, m_contact != nullptr);
   settings.tolerance = m_settings.newton.tolerance;
+  settings.exact_hessian = m_settings.newton.exact_hessian;
   settings.force_scale = f_int.norm() + f_ext.norm() + m_mass.cwiseProduct(m_v).norm() / h +
                          mass.cwiseProduct(q - predicted).norm() / (h * h);
   const double size = (m_body.rest.colwise().maxCoeff() - m_body.rest.colwise().minCoeff()).norm();

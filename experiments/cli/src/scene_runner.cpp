@@ -632,11 +632,14 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                   << ": it does not capture this scene (precompute it with these loads, or at a "
                      "tighter --tolerance)\n";
       } else {
-        // Only the limits this run has can have refused a refinement.
+        // Only the limits this run has can have refused a refinement; the deepest level allowed
+        // always is one.
         const HierarchySettings& h = adaptive->settings();
         std::vector<std::string> limits;
         if (h.criteria.max_level >= 0 && h.criteria.max_level < h.levels)
           limits.push_back("hierarchy.max_level");
+        else
+          limits.push_back("the finest level (hierarchy.levels)");
         if (h.criteria.max_active_elements > 0) limits.push_back("hierarchy.max_active_elements");
         if (is_explicit(scene.solver)) limits.push_back("the explicit step limit");
         if (h.criteria.min_steps_between_changes > 0)
@@ -650,7 +653,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
         const auto count = [](long n, const char* one, const char* many) {
           return std::to_string(n) + " " + (n == 1 ? one : many);
         };
-        if (report.refused_refinements > 0 && !limits.empty())
+        if (report.refused_refinements > 0)
           std::cerr << "; " << count(report.refused_refinements, "refusal", "refusals")
                     << " to refine (a tet refused at several passes counts at each) by "
                     << either(limits);

@@ -7,7 +7,7 @@
 /// Hessian: the exact Hessian where it is positive definite — tried first, so Newton converges
 /// quadratically near a stable equilibrium; where it is not (past an instability: a compressed
 /// body folding, a path past a bifurcation), the exact Hessian plus s·d·I, d its largest diagonal
-/// entry, for the first s of 10⁻⁴ · 4ᵏ up to 1 that makes it positive definite (the next
+/// entry, for the first s of 10⁻⁴ · 4ᵏ (then 1) whose solve succeeds and descends (the next
 /// iteration starts at s/4); where none does, the PSD-projected one (per element), after which
 /// the exact Hessian is skipped for 1, 2, 4, … iterations before it is tried again. Plain CG
 /// (incomplete Cholesky) uses the projected Hessian only; multigrid-PCG tries the exact one and

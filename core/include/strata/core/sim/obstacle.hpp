@@ -35,8 +35,9 @@ void validate_obstacle(const Obstacle& obstacle);
 
 /// Explicit integrators: every vertex inside an obstacle (φ < 0; not `skip[3 i]`) is moved onto
 /// its surface along ∇φ, its inward normal velocity relative to the obstacle removed and its
-/// tangential relative speed reduced by μ |Δv_n| (clamped at 0). Returns the contacts, and in
-/// `deepest` (if given) the largest depth −φ a vertex had reached (0 when none was inside).
+/// tangential relative speed reduced by μ |Δv_n| (clamped at 0). Returns the vertex–obstacle
+/// pairs projected, and in `deepest` (if given) the largest depth −φ a vertex had reached (0
+/// when none was inside).
 Index project_obstacle_contact(const std::vector<Obstacle>& obstacles, double t, VectorXd& x,
                                VectorXd& v, const std::vector<char>& skip,
                                double* deepest = nullptr);

@@ -243,9 +243,10 @@ class Simulation final : public SimulationRun {
   /// friction slip), the largest depth of a contact point inside an obstacle after any step so
   /// far [m], the point–obstacle pairs in contact after each step, and the contact forces the
   /// obstacles exert now (3·#Q [N], normal and friction). Explicit integrators, which project
-  /// the DOF vertices out of the obstacles after each step, report the vertices projected in it,
-  /// the depth the deepest had reached, and as contact forces the momentum the projection
-  /// changed over the step, M Δv / h.
+  /// the DOF vertices out of the obstacles after each step, report the vertex–obstacle pairs
+  /// projected in it, the depth the deepest vertex had reached, and as contact forces the
+  /// momentum the projection changed over the step, M Δv / h: forces of the last step, zero
+  /// after a state set from outside (set_state, a new cut) until the next step.
   bool has_obstacles() const { return !m_obstacles.empty(); }
   const ContactSettings& contact_settings() const;
   double max_penetration() const { return m_max_penetration; }
@@ -357,6 +358,8 @@ class Simulation final : public SimulationRun {
   void record_contact(const VectorXd& q_start, double t0, double t1);
   SimulationCounters m_newton;  ///< Newton and plasticity fields only
   void record_newton(const NewtonResult& result);
+  /// Forgets the last explicit projection (a state set from outside has not been through it).
+  void clear_projection();
 };
 
 }  // namespace strata

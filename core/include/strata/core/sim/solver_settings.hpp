@@ -54,8 +54,8 @@ struct SolverSettings {
 
   /// Ground and obstacle contact.
   struct Contact {
-    /// Ground penalty stiffness factor (static mode), see ground_penalty_stiffness. Scene:
-    /// solver.contact_stiffness_factor.
+    /// Ground penalty stiffness factor (ProblemSpec::ground, static mode), see
+    /// ground_penalty_stiffness. Library only: the scene's `ground` is an obstacle.
     double ground_stiffness_factor = 100.0;
     /// Obstacle contact (energy/contact_term.hpp): the tolerance d̂ [m], the deepest a vertex can
     /// enter an obstacle (0: 1e-3 × the bounding-box diagonal), and the friction slip ε [m] per
