@@ -494,6 +494,20 @@ TEST(ContactScenes, StartingInsideAnObstacleIsAnError) {
     EXPECT_NE(std::string(error.what()).find("obstacles.0: contact point"), std::string::npos)
         << error.what();
   }
+  // A sphere wholly inside the cube touches no contact point: it could never act.
+  try {
+    Simulation sim(
+        cube(),
+        {.material = rubber(), .obstacles = {sphere_obstacle(Vector3d(0.05, 0.05, 0.05), 0.01)}},
+        settings);
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("inside the obstacle: the obstacle overlaps the "
+                        "body's inside"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace

@@ -227,6 +227,20 @@ Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& 
     const double t = is_static() ? 0.0 : time();
     m_contact->set_step(m_x, t, t);
     m_contact->require_feasible(m_x, "contact point");
+    // Only the boundary is tested for contact: an obstacle that reaches the body's inside
+    // without touching a contact point (one wholly inside the body) would never act.
+    const VectorXd& x = positions();
+    for (const Obstacle& obstacle : m_obstacles)
+      for (Index v = 0; v < m_mesh.vertices.rows(); ++v) {
+        Vector3d gradient;
+        const double phi = obstacle.distance_at(x.segment<3>(3 * v), t, gradient);
+        if (phi > -m_contact->settings().distance) continue;
+        char depth[32];
+        std::snprintf(depth, sizeof depth, "%.3g", -phi);
+        throw InputError(obstacle.name + ": mesh vertex " + std::to_string(v) + " starts " + depth +
+                         " m inside the obstacle: the obstacle overlaps the body's inside, where "
+                         "no contact point can meet it");
+      }
   }
 }
 
