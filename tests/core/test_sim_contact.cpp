@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <random>
 
@@ -385,18 +386,26 @@ TEST(ContactScenes, PointsBoundByWeightsCarryTheBodyWhereItsVerticesDoNotTouch) 
   EXPECT_LE(sim.max_penetration(), sim.contact_settings().distance);
 }
 
-TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
+/// `mesh` under gravity above the ground z = 0, symplectic Euler steps of 20 µs for `duration`.
+std::unique_ptr<Simulation> explicit_on_ground(const TetMesh& mesh, const Material& material,
+                                               double duration) {
   SolverSettings settings;
   settings.integrator = Integrator::symplectic_euler;
   settings.dt = 2e-5;
-  settings.duration = 0.02;
-  TetMesh mesh = cube();
-  mesh.vertices.col(2).array() += 0.001;
-  Simulation sim(mesh,
-                 {.material = rubber(),
+  settings.duration = duration;
+  return std::make_unique<Simulation>(
+      mesh,
+      ProblemSpec{.material = material,
                   .gravity = Vector3d(0, 0, -9.81),
                   .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
-                 settings);
+      settings);
+}
+
+TEST(ContactScenes, ExplicitStepsProjectOntoTheObstacle) {
+  TetMesh mesh = cube();
+  mesh.vertices.col(2).array() += 0.001;
+  const std::unique_ptr<Simulation> run = explicit_on_ground(mesh, rubber(), 0.02);
+  Simulation& sim = *run;
   VectorXd v = VectorXd::Zero(sim.dof_velocities().size());
   for (Index i = 2; i < v.size(); i += 3)
     v[i] = -0.5;
@@ -412,28 +421,23 @@ TEST(ContactScenes, ExplicitStepsReportTheProjectedContactsAndTheirForces) {
   // projection is its contact. The 3 × 3 bottom vertices are in contact, the depth they reached
   // before the projection is reported, and the contact forces (the momentum the projection
   // changes, M Δv / h) carry the cube's weight, averaged over the last 10 ms.
-  SolverSettings settings;
-  settings.integrator = Integrator::symplectic_euler;
-  settings.dt = 2e-5;
-  settings.duration = 0.1;
   Material material = rubber();
   material.mass_damping = 100.0;
-  Simulation sim(cube(),
-                 {.material = material,
-                  .gravity = Vector3d(0, 0, -9.81),
-                  .obstacles = {plane_obstacle("ground", Vector3d::Zero(), Vector3d::UnitZ())}},
-                 settings);
+  const double duration = 0.1;
+  const std::unique_ptr<Simulation> run = explicit_on_ground(cube(), material, duration);
+  Simulation& sim = *run;
+  const double dt = sim.settings().dt;
   const double weight = 9.81 * sim.vertex_mass().sum();
   double impulse = 0.0, elapsed = 0.0;
   while (!sim.finished()) {
     sim.advance();
-    if (sim.time() <= settings.duration - 0.01 + 1e-12) continue;
+    if (sim.time() <= duration - 0.01 + 1e-12) continue;
     const VectorXd f = sim.contact_forces();
     double fz = 0.0;
     for (Index v = 0; v < f.size() / 3; ++v)
       fz += f[3 * v + 2];
-    impulse += fz * settings.dt;
-    elapsed += settings.dt;
+    impulse += fz * dt;
+    elapsed += dt;
   }
   EXPECT_NEAR(impulse / elapsed, weight, 0.01 * weight);
   EXPECT_EQ(sim.contact_counts().size(), static_cast<std::size_t>(sim.step_count()));

@@ -183,6 +183,14 @@ VectorXd EmbeddedElasticModel::reduce_vertex_scalar(ConstRef<VectorXd> s) const 
   return m_CT * s;
 }
 
+VectorXd EmbeddedElasticModel::at_dof_vertices(ConstRef<VectorXd> on_dofs) const {
+  if (m_identity) return on_dofs;
+  VectorXd on_mesh = VectorXd::Zero(3 * m_C.rows());
+  for (Index q = 0; q < m_num_dof_vertices; ++q)
+    on_mesh.segment<3>(3 * Index(m_dof_vertices[q])) = on_dofs.segment<3>(3 * q);
+  return on_mesh;
+}
+
 double EmbeddedElasticModel::energy(ConstRef<VectorXd> q) const {
   if (m_identity) return m_model->energy(q);
   return m_model->energy(expand(q));

@@ -215,16 +215,12 @@ std::shared_ptr<MultigridCoarseLevels> SpdSolver::release_coarse_levels() {
 }
 
 bool SpdSolver::solve_if_definite(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {
-  m_probing = true;
-  bool solved = false;
-  try {
-    solved = solve(A, b, x);
-  } catch (...) {
-    m_probing = false;
-    throw;
-  }
-  m_probing = false;
-  return solved;
+  struct Probing {
+    bool& flag;
+    explicit Probing(bool& f) : flag(f) { flag = true; }
+    ~Probing() { flag = false; }
+  } probing(m_probing);
+  return solve(A, b, x);
 }
 
 bool SpdSolver::solve(const SparseMatrixd& A, ConstRef<VectorXd> b, VectorXd& x) {

@@ -8,19 +8,27 @@ namespace strata {
 
 namespace {
 
+double largest_diagonal(const SparseMatrixd& H) {
+  double largest = 0.0;
+  for (Index i = 0; i < H.rows(); ++i)
+    largest = std::max(largest, H.coeff(i, i));
+  return largest;
+}
+
+/// H + shift · I.
+SparseMatrixd shifted_matrix(const SparseMatrixd& H, double shift) {
+  SparseMatrixd shifted = H;
+  for (Index i = 0; i < H.rows(); ++i)
+    shifted.coeffRef(i, i) += shift;
+  return shifted;
+}
+
 /// Solves H Δ = rhs, adding τ I to H if it is not numerically positive definite.
 bool solve_with_shift(SpdSolver& solver, SparseMatrixd& H, const VectorXd& rhs, VectorXd& step) {
   if (solver.solve(H, rhs, step)) return true;
-  double max_diagonal = 0.0;
-  for (Index i = 0; i < H.rows(); ++i)
-    max_diagonal = std::max(max_diagonal, H.coeff(i, i));
-  double shift = 1e-10 * std::max(max_diagonal, 1e-300);
-  for (int attempt = 0; attempt < 12; ++attempt, shift *= 10.0) {
-    SparseMatrixd shifted = H;
-    for (Index i = 0; i < H.rows(); ++i)
-      shifted.coeffRef(i, i) += shift;
-    if (solver.solve(shifted, rhs, step)) return true;
-  }
+  double shift = 1e-10 * std::max(largest_diagonal(H), 1e-300);
+  for (int attempt = 0; attempt < 12; ++attempt, shift *= 10.0)
+    if (solver.solve(shifted_matrix(H, shift), rhs, step)) return true;
   return false;
 }
 
@@ -76,16 +84,12 @@ class HessianChoice {
 double solve_shifted_exact(SpdSolver& solver, const SparseMatrixd& H, const VectorXd& rhs,
                            VectorXd& step, double first) {
   if (first == 0.0 && solver.solve(H, rhs, step) && rhs.dot(step) > 0.0) return 0.0;
-  double max_diagonal = 0.0;
-  for (Index i = 0; i < H.rows(); ++i)
-    max_diagonal = std::max(max_diagonal, H.coeff(i, i));
-  if (!(max_diagonal > 0.0) || !std::isfinite(max_diagonal)) return -1.0;
+  const double d = largest_diagonal(H);
+  if (!(d > 0.0) || !std::isfinite(d)) return -1.0;
   for (double shift = std::max(first, HessianChoice::kFirstShift);;
        shift = std::min(shift * HessianChoice::kShiftFactor, HessianChoice::kLastShift)) {
-    SparseMatrixd shifted = H;
-    for (Index i = 0; i < H.rows(); ++i)
-      shifted.coeffRef(i, i) += shift * max_diagonal;
-    if (solver.solve_if_definite(shifted, rhs, step) && rhs.dot(step) > 0.0) return shift;
+    if (solver.solve_if_definite(shifted_matrix(H, shift * d), rhs, step) && rhs.dot(step) > 0.0)
+      return shift;
     if (shift >= HessianChoice::kLastShift) return -1.0;
   }
 }

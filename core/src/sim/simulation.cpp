@@ -227,20 +227,7 @@ Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& 
     const double t = is_static() ? 0.0 : time();
     m_contact->set_step(m_x, t, t);
     m_contact->require_feasible(m_x, "contact point");
-    // Only the boundary is tested for contact: an obstacle that reaches the body's inside
-    // without touching a contact point (one wholly inside the body) would never act.
-    const VectorXd& x = positions();
-    for (const Obstacle& obstacle : m_obstacles)
-      for (Index v = 0; v < m_mesh.vertices.rows(); ++v) {
-        Vector3d gradient;
-        const double phi = obstacle.distance_at(x.segment<3>(3 * v), t, gradient);
-        if (phi > -m_contact->settings().distance) continue;
-        char depth[32];
-        std::snprintf(depth, sizeof depth, "%.3g", -phi);
-        throw InputError(obstacle.name + ": mesh vertex " + std::to_string(v) + " starts " + depth +
-                         " m inside the obstacle: the obstacle overlaps the body's inside, where "
-                         "no contact point can meet it");
-      }
+    m_contact->require_clear_inside(positions());
   }
 }
 
@@ -387,13 +374,7 @@ void Simulation::record_contact(const VectorXd& q_start, double t0, double t1) {
 VectorXd Simulation::mesh_contact_forces() const {
   VectorXd f = VectorXd::Zero(3 * m_mesh.vertices.rows());
   if (!m_contact) return f;
-  if (m_stepper_traits->is_explicit) {
-    const VectorXd on_dofs = contact_forces();
-    for (Index q = 0; q < m_embedded->num_dof_vertices(); ++q)
-      f.segment<3>(3 * Index(m_embedded->is_identity() ? q : m_embedded->dof_vertices()[q])) =
-          on_dofs.segment<3>(3 * q);
-    return f;
-  }
+  if (m_stepper_traits->is_explicit) return m_embedded->at_dof_vertices(contact_forces());
   const std::vector<Vector3d> point_forces = m_contact->point_forces(m_x, false);
   for (size_t p = 0; p < point_forces.size(); ++p) {
     if (point_forces[p].isZero()) continue;

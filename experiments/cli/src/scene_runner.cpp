@@ -632,16 +632,18 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
                   << ": it does not capture this scene (precompute it with these loads, or at a "
                      "tighter --tolerance)\n";
       } else {
-        // Only the limits this run has can have refused a refinement; the deepest level allowed
-        // always is one.
+        // Only the limits this run has can have refused a refinement: the deepest level allowed
+        // and the explicit step limit keep tets from refining at all, the element budget and
+        // hysteresis for a while.
         const HierarchySettings& h = adaptive->settings();
-        std::vector<std::string> limits;
+        std::vector<std::string> hard;
         if (h.criteria.max_level >= 0 && h.criteria.max_level < h.levels)
-          limits.push_back("hierarchy.max_level");
+          hard.push_back("hierarchy.max_level");
         else
-          limits.push_back("the finest level (hierarchy.levels)");
+          hard.push_back("the finest level (hierarchy.levels)");
+        if (is_explicit(scene.solver)) hard.push_back("the explicit step limit");
+        std::vector<std::string> limits = hard;
         if (h.criteria.max_active_elements > 0) limits.push_back("hierarchy.max_active_elements");
-        if (is_explicit(scene.solver)) limits.push_back("the explicit step limit");
         if (h.criteria.min_steps_between_changes > 0)
           limits.push_back("hysteresis (hierarchy.min_steps_between_changes)");
         const auto either = [&](const std::vector<std::string>& names) {
@@ -657,14 +659,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
           std::cerr << "; " << count(report.refused_refinements, "refusal", "refusals")
                     << " to refine (a tet refused at several passes counts at each) by "
                     << either(limits);
-        if (report.steps_unrefinable > 0) {
-          std::vector<std::string> hard;
-          for (const std::string& name : limits)
-            if (name.rfind("hysteresis", 0) != 0) hard.push_back(name);
+        if (report.steps_unrefinable > 0)
           std::cerr << "; " << count(report.steps_unrefinable, "decision", "decisions")
-                    << " on a cut no tet of which may refine"
-                    << (hard.empty() ? std::string() : " (" + either(hard) + ")");
-        }
+                    << " on a cut no tet of which may refine (" << either(hard) << ")";
         if (report.steps_out_of_passes > 0)
           std::cerr << "; " << count(report.steps_out_of_passes, "step", "steps")
                     << " still refining after all " << h.max_passes << " hierarchy.max_passes";

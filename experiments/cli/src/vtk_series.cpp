@@ -52,12 +52,8 @@ void VtkSeries::write_frame(double time, const Simulation& simulation, const Vec
   if (simulation.has_obstacles()) {
     // The obstacles' forces on the DOFs (normal and friction), at the DOF vertices; a hanging
     // vertex's share is carried by the vertices it follows.
-    const VectorXd on_dofs = simulation.contact_forces();
-    const EmbeddedElasticModel& model = simulation.embedded_model();
-    VectorXd on_mesh = VectorXd::Zero(3 * mesh.vertices.rows());
-    for (Index q = 0; q < model.num_dof_vertices(); ++q)
-      on_mesh.segment<3>(3 * (model.is_identity() ? q : model.dof_vertices()[q])) =
-          on_dofs.segment<3>(3 * q);
+    const VectorXd on_mesh =
+        simulation.embedded_model().at_dof_vertices(simulation.contact_forces());
     fields.add_point_data("contact_force", Eigen::MatrixXd(unflatten(on_mesh)));
   }
   if (simulation.is_plastic()) {

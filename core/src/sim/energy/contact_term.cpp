@@ -48,6 +48,15 @@ void add_block(SparseMatrixd& hessian, int a, int b, const Matrix3d& block) {
   }
 }
 
+/// "<obstacle>: <what> <index> starts D m inside the obstacle".
+std::string deep_start(const Obstacle& obstacle, const std::string& what, Index index,
+                       double depth) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", depth);
+  return obstacle.name + ": " + what + " " + std::to_string(index) + " starts " + text +
+         " m inside the obstacle";
+}
+
 }  // namespace
 
 ContactTerm::ContactTerm(const std::vector<Obstacle>& obstacles, const std::vector<int>& vertices,
@@ -261,19 +270,28 @@ Index ContactTerm::add_normal_forces(ConstRef<VectorXd> q, VectorXd& f) const {
 }
 
 void ContactTerm::require_feasible(ConstRef<VectorXd> q, const std::string& point_name) const {
-  const auto format = [](double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.3g", value);
-    return std::string(text);
-  };
   for (const Obstacle& obstacle : m_obstacles)
     for (Index p = 0; p < num_points(); ++p) {
       Vector3d gradient;
       const double phi = obstacle.distance_at(position(q, p), m_time, gradient);
+      if (!(phi > -m_settings.distance)) {
+        char tolerance[32];
+        std::snprintf(tolerance, sizeof tolerance, "%.3g", m_settings.distance);
+        throw InputError(deep_start(obstacle, point_name, p, -phi) +
+                         " (more than the contact tolerance " + tolerance + " m)");
+      }
+    }
+}
+
+void ContactTerm::require_clear_inside(ConstRef<VectorXd> x) const {
+  for (const Obstacle& obstacle : m_obstacles)
+    for (Index v = 0; v < x.size() / 3; ++v) {
+      Vector3d gradient;
+      const double phi = obstacle.distance_at(x.segment<3>(3 * v), m_time, gradient);
       if (!(phi > -m_settings.distance))
-        throw InputError(obstacle.name + ": " + point_name + " " + std::to_string(p) + " starts " +
-                         format(-phi) + " m inside the obstacle (more than the contact tolerance " +
-                         format(m_settings.distance) + " m)");
+        throw InputError(deep_start(obstacle, "mesh vertex", v, -phi) +
+                         ": the obstacle overlaps the body's inside, where no contact point can "
+                         "meet it");
     }
 }
 

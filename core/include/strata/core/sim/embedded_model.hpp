@@ -68,6 +68,9 @@ class EmbeddedElasticModel {
   VectorXd reduce(ConstRef<VectorXd> f) const;
   /// Cᵀ s (#V → #Q): lumped vertex masses (total mass kept since C·1 = 1).
   VectorXd reduce_vertex_scalar(ConstRef<VectorXd> s) const;
+  /// A vector on the DOFs (3·#Q) placed at the DOF vertices' mesh vertices (3·#V), zero at the
+  /// others (hanging vertices): point values such as forces, not an interpolation.
+  VectorXd at_dof_vertices(ConstRef<VectorXd> on_dofs) const;
 
   /// Ψ(P q) [J].
   double energy(ConstRef<VectorXd> q) const;

@@ -87,6 +87,11 @@ class ContactTerm final : public EnergyTerm {
   /// contact tolerance d̂ m)" for the first point deeper than d̂ at the end-of-step placement: a
   /// start the barrier cannot take.
   void require_feasible(ConstRef<VectorXd> q, const std::string& point_name) const;
+  /// Throws InputError "<obstacle>: mesh vertex v starts D m inside the obstacle: …" for the
+  /// first of the mesh positions `x` (3·#V) deeper than d̂ at the end-of-step placement: only
+  /// the contact points are tested for contact, so an obstacle that reaches the body's inside
+  /// without meeting one (a sphere wholly inside the body) could never act.
+  void require_clear_inside(ConstRef<VectorXd> x) const;
   /// The contact force on each point (num_points() entries, summed over the obstacles; zero
   /// where none acts): the barrier's, and with `friction` the lagged friction's too.
   std::vector<Vector3d> point_forces(ConstRef<VectorXd> q, bool friction) const;
