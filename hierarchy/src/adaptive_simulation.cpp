@@ -741,15 +741,15 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   state.recovery_geometry = cut_geometry();
   state.solution_energy_scale = std::max(m_energy_scale, m_energy_floor);
   state.solution_displacement_scale = std::max(m_displacement_scale, m_displacement_floor);
-  state.tolerance_scale = m_estimate_scale;
+  const double scale = estimate_scale();
+  state.tolerance_scale = scale;
   m_estimate = recovery_error_estimate(state);
   m_estimate_valid = true;
   state.recovery_estimate = &m_estimate;
   // An error-estimating indicator refines only while the run's estimate exceeds the tolerance
   // (a calibration pass: its target).
-  const bool within_tolerance =
-      calibration_target <= 0.0 && m_estimates_error &&
-      m_estimate_scale * m_estimate.relative_error <= m_settings.tolerance;
+  const bool within_tolerance = calibration_target <= 0.0 && m_estimates_error &&
+                                scale * m_estimate.relative_error <= m_settings.tolerance;
   if (calibration_target > 0.0) state.tolerance_scale = m_settings.tolerance / calibration_target;
   if (!coarsen && (!refine || within_tolerance)) return {};
   // A cut none of whose tets may refine (max_level, the explicit step limit) asks the controller
@@ -762,7 +762,7 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   // estimate creeps up (a soft body sagging) would otherwise trip the test again a few steps
   // later, and every trip redoes a step.
   if (refine && !coarsen && !is_static(m_solver) && calibration_target <= 0.0)
-    state.tolerance_scale = m_estimate_scale / m_settings.coarsen_budget;
+    state.tolerance_scale = scale / m_settings.coarsen_budget;
   fields = sim.model().tet_fields(sim.positions());
   // No merges while a load with an amplitude is still growing: the estimate of the current state
   // cannot see a load that is still to come, and merges made where it will act would meet it on
@@ -909,6 +909,10 @@ void AdaptiveSimulation::change_cut(const CutChanges& changes, int pass, long fi
   m_bookkeeping_seconds += record.seconds;
   m_changes.push_back(record);
   m_simulation_change = static_cast<std::ptrdiff_t>(m_changes.size()) - 1;
+}
+
+double AdaptiveSimulation::estimate_scale() const {
+  return is_explicit(m_solver) ? kExplicitOvershoot * m_estimate_scale : m_estimate_scale;
 }
 
 void AdaptiveSimulation::note_solver_setups() {
@@ -1071,7 +1075,7 @@ void AdaptiveSimulation::record_sample() {
   if (m_settings.mode != HierarchyMode::full &&
       !m_at_full_resolution) {  // full resolution: zero by definition
     const RecoveryEstimate& estimate = estimate_error();
-    sample.estimated_error = m_estimate_scale * estimate.relative_error;
+    sample.estimated_error = estimate_scale() * estimate.relative_error;
     sample.estimated_energy_error = estimate.relative_energy_error;
     sample.estimated_upper_error = estimate.upper_error;
     sample.estimated_load_work_error = estimate.load_work_error;

@@ -343,6 +343,16 @@ class AdaptiveSimulation final : public SimulationRun {
   /// stands, 1 when it is within the estimate).
   void measure_estimate(double refined_estimate, const VectorXd& solved, const VectorXd& carried);
   double m_estimate_scale = 1.0;
+  /// The factor on the estimate of the run's decisions and samples (not of the initial
+  /// adaptation's static responses): m_estimate_scale, times kExplicitOvershoot with an explicit
+  /// integrator.
+  double estimate_scale() const;
+  /// Explicit integrators add no numerical damping. The error a coarse cut commits under a
+  /// residual that appears suddenly (an impact, a load switched on) then overshoots the estimate
+  /// of the state, which reads that residual as if it were static, by up to the dynamic load
+  /// factor of an undamped oscillator under a step load, 2 (backward Euler damps the overshoot
+  /// at the project's step sizes).
+  static constexpr double kExplicitOvershoot = 2.0;
   /// Static runs: each active tet's share of the estimate (η_t,full² / ‖u‖_E², per flat tet) on
   /// the cut a load step's passes ended on, or on a cut no pass has measured yet; empty after a
   /// cut change. When the shares that grew since then add up to more than (kCalibrationGrowth² − 1)
