@@ -46,7 +46,15 @@ bool is_static(const SolverSettings& settings) {
 }
 
 bool is_explicit(const SolverSettings& settings) {
-  return !is_static(settings) && settings.integrator != Integrator::implicit_euler;
+  if (is_static(settings)) return false;
+  switch (settings.integrator) {
+    case Integrator::symplectic_euler:
+    case Integrator::rk4:
+      return true;
+    case Integrator::implicit_euler:
+      return false;
+  }
+  return false;
 }
 
 /// Whether every active tet is at `max_level` (nothing left to refine).

@@ -177,7 +177,8 @@ struct CutSample {
   Index dofs = 0;     ///< 3·#free vertices
   Index hanging = 0;  ///< hanging vertices
   /// Estimated relative displacement error against full resolution after the step
-  /// (refinement_recovery_estimator.hpp).
+  /// (refinement_recovery_estimator.hpp), times the run's estimate scale (a measured static
+  /// scale; with an explicit integrator, also kExplicitOvershoot).
   double estimated_error = 0.0;
   /// Relative energy-norm error against the exact solution (the estimate's raw form).
   double estimated_energy_error = 0.0;
@@ -347,11 +348,11 @@ class AdaptiveSimulation final : public SimulationRun {
   /// adaptation's static responses): m_estimate_scale, times kExplicitOvershoot with an explicit
   /// integrator.
   double estimate_scale() const;
-  /// Explicit integrators add no numerical damping. The error a coarse cut commits under a
-  /// residual that appears suddenly (an impact, a load switched on) then overshoots the estimate
-  /// of the state, which reads that residual as if it were static, by up to the dynamic load
-  /// factor of an undamped oscillator under a step load, 2 (backward Euler damps the overshoot
-  /// at the project's step sizes).
+  /// Explicit integrators add no numerical damping (nor does material damping lower the factor).
+  /// The error a coarse cut commits under a residual that appears suddenly (an impact, a load
+  /// switched on) then overshoots the estimate of the state, which reads that residual as if it
+  /// were static, by up to the dynamic load factor of an undamped oscillator under a step load, 2
+  /// (backward Euler damps the overshoot at the project's step sizes).
   static constexpr double kExplicitOvershoot = 2.0;
   /// Static runs: each active tet's share of the estimate (η_t,full² / ‖u‖_E², per flat tet) on
   /// the cut a load step's passes ended on, or on a cut no pass has measured yet; empty after a
