@@ -351,10 +351,12 @@ void AdaptiveSimulation::initial_adaptation() {
     state.recovery_geometry = cut_geometry();
     state.solution_energy_scale = m_energy_floor;
     state.solution_displacement_scale = m_displacement_floor;
-    state.tolerance_scale = m_estimate_scale;
+    // The run's loads act suddenly at its first step: an explicit run's response overshoots the
+    // static one as its error does (kExplicitOvershoot), so the cut is adapted with its factor.
+    state.tolerance_scale = estimate_scale();
     const RecoveryEstimate estimate = recovery_error_estimate(state);
     state.recovery_estimate = &estimate;
-    const double scaled = m_estimate_scale * estimate.relative_error;
+    const double scaled = estimate_scale() * estimate.relative_error;
     bool calibrate = false;
     if (m_estimates_error && scaled <= m_settings.tolerance) {
       calibrate =

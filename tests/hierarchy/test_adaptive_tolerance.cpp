@@ -99,6 +99,10 @@ double run_error(const std::vector<MatrixX3d>& run, const std::vector<MatrixX3d>
   return error / scale;
 }
 
+Index full_run_tets(const PokedPlate& plate) {
+  return plate.coarse.tets.rows() * 64;
+}
+
 std::vector<MatrixX3d> full_run(const PokedPlate& plate) {
   HierarchySettings h = defaults(2);
   h.mode = HierarchyMode::full;
@@ -311,6 +315,30 @@ TEST(AdaptiveTolerance, ImplicitRunsTakeTheEstimateAsItIs) {
       plate.solver());
   plate.run(sim);
   expect_samples_scaled_by(sim, 1.0);
+}
+
+TEST(AdaptiveTolerance, AnExplicitRunAdaptsItsFirstCutWithTheFactor) {
+  // The loads act suddenly at the first step: an explicit run adapts its first cut to the static
+  // response with the factor on the estimate, so it starts on a finer cut than backward Euler's.
+  const PokedPlate plate;
+  const ProblemSpec problem{
+      .material = plate.material(), .dirichlet = plate.fixed, .loads = plate.loads};
+  SolverSettings settings = plate.solver();
+  HierarchySettings full = defaults(2);
+  full.mode = HierarchyMode::full;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.dt = 1.0;
+  const double finest_dt =
+      AdaptiveSimulation(plate.coarse, full, problem, settings).simulation().stable_dt_estimate();
+  settings.dt = 0.5 * finest_dt;  // no refinement refused for the step limit
+  HierarchySettings h = defaults(2);
+  h.tolerance = 0.05;
+  const AdaptiveSimulation explicit_run(plate.coarse, h, problem, settings);
+  const AdaptiveSimulation implicit_run(plate.coarse, h, problem, plate.solver());
+  EXPECT_EQ(explicit_run.tolerance_report().refused_refinements, 0);
+  EXPECT_LT(implicit_run.cut().size(), full_run_tets(plate));
+  EXPECT_GT(explicit_run.cut().size(), implicit_run.cut().size());
+  EXPECT_LT(explicit_run.cut().size(), full_run_tets(plate));
 }
 
 TEST(AdaptiveTolerance, AToleranceTheCutCannotMeetIsReported) {
