@@ -11,6 +11,7 @@
 #include "strata/core/sim/loads.hpp"
 #include "strata/core/sim/region.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
+#include "strata/core/sim/steppers/time_stepper.hpp"
 #include "strata/hierarchy/cut_levels.hpp"
 #include "strata/hierarchy/cut_state.hpp"
 #include "strata/hierarchy/cut_transfer.hpp"
@@ -46,15 +47,7 @@ bool is_static(const SolverSettings& settings) {
 }
 
 bool is_explicit(const SolverSettings& settings) {
-  if (is_static(settings)) return false;
-  switch (settings.integrator) {
-    case Integrator::symplectic_euler:
-    case Integrator::rk4:
-      return true;
-    case Integrator::implicit_euler:
-      return false;
-  }
-  return false;
+  return find_stepper(settings).is_explicit;
 }
 
 /// Whether every active tet is at `max_level` (nothing left to refine).

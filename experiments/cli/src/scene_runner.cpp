@@ -25,6 +25,7 @@
 #include "strata/core/mesh/point_location.hpp"
 #include "strata/core/sim/simulation.hpp"
 #include "strata/core/sim/stable_time_step.hpp"
+#include "strata/core/sim/steppers/time_stepper.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
 #include "strata/meshing/implicit_shape.hpp"
 #include "strata/meshing/level_set_obstacle.hpp"
@@ -37,8 +38,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 bool is_explicit(const SolverSettings& settings) {
-  return settings.mode == SimulationMode::dynamic &&
-         settings.integrator != Integrator::implicit_euler;
+  return find_stepper(settings).is_explicit;
 }
 
 }  // namespace

@@ -344,9 +344,8 @@ class AdaptiveSimulation final : public SimulationRun {
   /// stands, 1 when it is within the estimate).
   void measure_estimate(double refined_estimate, const VectorXd& solved, const VectorXd& carried);
   double m_estimate_scale = 1.0;
-  /// The factor on the estimate of the run's decisions and samples (not of the initial
-  /// adaptation's static responses): m_estimate_scale, times kExplicitOvershoot with an explicit
-  /// integrator.
+  /// The factor on the estimate of the run's decisions, samples and initial adaptation:
+  /// m_estimate_scale, times kExplicitOvershoot with an explicit integrator.
   double estimate_scale() const;
   /// Explicit integrators add no numerical damping (nor does material damping lower the factor).
   /// The error a coarse cut commits under a residual that appears suddenly (an impact, a load
