@@ -468,33 +468,43 @@ bool AdaptiveSimulation::cut_can_refine() const {
 }
 
 bool AdaptiveSimulation::children_stable(NodeId n) const {
-  // The eight children as a mesh of their own: its lumped masses are at most those of the
-  // children in any cut, so its estimate is a lower bound of theirs (refusal errs on the safe
-  // side). The answer holds for the whole run (the shapes, the material and dt stay), so it is
-  // kept per node, by its place in the tree, which outlives node ids.
+  // The eight children as a group of their own (stable_time_step.hpp): the group bound holds for
+  // any cut that holds them, whatever their neighbours. The answer holds for the whole run (the
+  // shapes, the material and dt stay), so it is kept per node, by its place in the tree, which
+  // outlives node ids.
   const std::pair<int, std::uint64_t> path = node_path(n);
   if (const auto known = m_children_stable.find(path); known != m_children_stable.end())
     return known->second;
-  const std::array<Matrix3x4d, 8> children = red_refine_tet(m_tree->bey_positions(n));
-  const bool stable = stable_on_their_own({children.begin(), children.end()});
+  const bool stable = stable_in_groups({red_refine_tet(m_tree->bey_positions(n))});
   m_children_stable.emplace(path, stable);
   return stable;
 }
 
-bool AdaptiveSimulation::stable_on_their_own(const std::vector<Matrix3x4d>& tets) const {
-  MatrixX3d vertices(4 * static_cast<Index>(tets.size()), 3);
-  MatrixX4i elements(static_cast<Index>(tets.size()), 4);
-  for (Index t = 0; t < elements.rows(); ++t) {
-    Matrix3x4d x = tets[t];
-    if ((x.col(1) - x.col(0)).cross(x.col(2) - x.col(0)).dot(x.col(3) - x.col(0)) < 0.0)
-      x.col(2).swap(x.col(3));
-    for (int c = 0; c < 4; ++c) {
-      vertices.row(4 * t + c) = x.col(c).transpose();
-      elements(t, c) = static_cast<int>(4 * t + c);
+bool AdaptiveSimulation::stable_in_groups(
+    const std::vector<std::array<Matrix3x4d, 8>>& groups) const {
+  // One mesh of the groups, the corners a group's children share merged (a midpoint is the same
+  // sum in every child that holds it).
+  MatrixX3d vertices(32 * static_cast<Index>(groups.size()), 3);
+  MatrixX4i elements(8 * static_cast<Index>(groups.size()), 4);
+  std::vector<int> group_of(8 * groups.size());
+  Index num_vertices = 0;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const Index first = num_vertices;
+    for (int c = 0; c < 8; ++c) {
+      const Index t = 8 * static_cast<Index>(g) + c;
+      group_of[t] = static_cast<int>(g);
+      for (int k = 0; k < 4; ++k) {
+        const Vector3d x = groups[g][c].col(k);
+        Index v = first;
+        while (v < num_vertices && vertices.row(v) != x.transpose())
+          ++v;
+        if (v == num_vertices) vertices.row(num_vertices++) = x.transpose();
+        elements(t, k) = static_cast<int>(v);
+      }
     }
   }
-  return stable_time_step_estimate(vertices, elements, m_material, m_solver.integrator) >=
-         m_solver.dt;
+  return stable_time_step_estimate(vertices.topRows(num_vertices), elements, m_material,
+                                   m_solver.integrator, group_of) >= m_solver.dt;
 }
 
 SimulationOptions AdaptiveSimulation::flatten(long first_step) {
@@ -510,6 +520,13 @@ SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads, &m_load_traction);
   options.first_step = first_step;
   options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
+  if (is_explicit(m_solver)) {
+    // The stable-step estimate over groups of siblings, as the refinement veto takes it; a root
+    // on its own.
+    options.stability_groups.resize(flat.tet_nodes.size());
+    for (std::size_t t = 0; t < flat.tet_nodes.size(); ++t)
+      options.stability_groups[t] = m_tree->parent(flat.tet_nodes[t]);
+  }
   add_contact(options);
   // The criteria see every load at its peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads) {
@@ -945,20 +962,35 @@ bool AdaptiveSimulation::past_full_resolution_fraction() const {
 
 bool AdaptiveSimulation::finest_level_stable() const {
   if (!m_finest_level_stable) {
-    // The bound is the largest over the tets (stable_time_step.hpp): the finest tets of each
-    // root as a mesh of their own.
+    // The bound over groups (stable_time_step.hpp): the finest level's tets in groups of eight
+    // siblings, root by root.
     bool stable = true;
     std::vector<Matrix3x4d> tets, children;
-    for (NodeId root = 0; root < m_tree->num_roots() && stable; ++root) {
+    std::vector<std::array<Matrix3x4d, 8>> groups;
+    if (m_tree->max_level() == 0) {  // the roots, each on its own
+      MatrixX3d vertices(4 * m_tree->num_roots(), 3);
+      MatrixX4i elements(m_tree->num_roots(), 4);
+      for (NodeId root = 0; root < m_tree->num_roots(); ++root)
+        for (int k = 0; k < 4; ++k) {
+          vertices.row(4 * root + k) = m_tree->bey_positions(root).col(k).transpose();
+          elements(root, k) = 4 * root + k;
+        }
+      stable = stable_time_step_estimate(vertices, elements, m_material, m_solver.integrator) >=
+               m_solver.dt;
+    }
+    for (NodeId root = 0; root < m_tree->num_roots() && stable && m_tree->max_level() > 0; ++root) {
       tets.assign(1, m_tree->bey_positions(root));
-      for (int level = 0; level < m_tree->max_level(); ++level) {
+      for (int level = 0; level + 1 < m_tree->max_level(); ++level) {
         children.clear();
         for (const Matrix3x4d& x : tets)
           for (const Matrix3x4d& child : red_refine_tet(x))
             children.push_back(child);
         tets.swap(children);
       }
-      stable = stable_on_their_own(tets);
+      groups.clear();
+      for (const Matrix3x4d& x : tets)
+        groups.push_back(red_refine_tet(x));
+      stable = stable_in_groups(groups);
     }
     m_finest_level_stable = stable;
   }

@@ -15,8 +15,12 @@
 #include <iostream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "cli_test_utils.hpp"
+#include "strata/core/fem/material.hpp"
+#include "strata/core/mesh/tet_mesh.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
 
 namespace strata::cli_test {
 namespace {
@@ -336,6 +340,40 @@ TEST(CliEndToEnd, AnInterruptedRunLeavesNoStatsFile) {
   EXPECT_EQ(WEXITSTATUS(status), 124);                       // stopped by the timeout, not finished
   EXPECT_TRUE(std::filesystem::exists(out / "probes.csv"));  // the run had started its outputs
   EXPECT_FALSE(std::filesystem::exists(out / "stats.json"));
+}
+
+TEST(CliEndToEnd, ExplicitBoxRunsBoundTheStableStepOverEachCell) {
+  // A box mesh's explicit run bounds the stable step over each cell's six tets
+  // (stable_time_step.hpp); an implicit run reports the single-tet bound, as a reference.
+  const TetMesh mesh = box_tet_mesh(Vector3d::Zero(), Vector3d(1, 0.1, 0.1), {10, 1, 1});
+  Material material;
+  material.model = MaterialModel::neohookean;
+  material.youngs_modulus = 1e9;
+  material.poisson_ratio = 0.3;
+  material.density = 1000;
+  std::vector<int> cells(mesh.tets.rows());
+  for (Index t = 0; t < mesh.tets.rows(); ++t)
+    cells[t] = static_cast<int>(t / 6);
+  const double element =
+      stable_time_step_estimate(mesh.vertices, mesh.tets, material, Integrator::symplectic_euler);
+  const double grouped = stable_time_step_estimate(mesh.vertices, mesh.tets, material,
+                                                   Integrator::symplectic_euler, cells);
+  EXPECT_GT(grouped, 1.2 * element);
+  for (const std::string integrator : {"symplectic_euler", "implicit_euler"}) {
+    TempFolder folder;
+    json scene = bar_scene();
+    scene["solver"] = {{"mode", "dynamic"},
+                       {"integrator", integrator},
+                       {"dt", 0.5 * element},
+                       {"duration", 5 * 0.5 * element}};
+    write_scene(folder, scene);
+    const CliResult result = run_strata("run scene.json -q", folder.path());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const json stats = read_json(folder.path() / "out" / "scene" / "stats.json");
+    const double expected = integrator == "symplectic_euler" ? grouped : element;
+    EXPECT_NEAR(stats["stable_dt_estimate"].get<double>(), expected, 1e-12 * expected)
+        << integrator;
+  }
 }
 
 TEST(CliEndToEnd, ExplicitRunBeyondStableStepDivergesWithExitCode3) {

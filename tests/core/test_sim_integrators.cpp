@@ -167,6 +167,91 @@ TEST(SimIntegrators, StableStepEstimateIsABoundOnTheTrueLimit) {
               2.0 * std::sqrt(2.0) / omega_bound, 1e-15 / omega_bound);
 }
 
+/// ω_max of the lumped-mass system linearised at rest, from a dense eigen-solve of M^-½ K M^-½
+/// with the elastic model's own stiffness.
+double true_max_angular_frequency(const TetMesh& mesh, const Material& material) {
+  const ElasticModel model(mesh.vertices, mesh.tets, material);
+  SparseMatrixd K;
+  model.stiffness(model.rest_positions(), K, false);
+  const VectorXd mass = lumped_vertex_mass(model.rest_data().rest_volume, mesh.tets,
+                                           model.num_vertices(), material.density);
+  VectorXd inverse_sqrt_mass(model.num_dofs());
+  for (Index i = 0; i < model.num_dofs(); ++i)
+    inverse_sqrt_mass[i] = 1.0 / std::sqrt(mass[i / 3]);
+  const Eigen::MatrixXd scaled =
+      inverse_sqrt_mass.asDiagonal() * Eigen::MatrixXd(K) * inverse_sqrt_mass.asDiagonal();
+  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled, Eigen::EigenvaluesOnly)
+                       .eigenvalues()
+                       .maxCoeff());
+}
+
+TEST(SimIntegrators, GroupedFrequencyBoundLiesBetweenTheTrueValueAndTheElementBound) {
+  // Any partition of the tets bounds ω_max (stable_time_step.hpp); a whole mesh as one group is
+  // its true ω_max, and larger groups bound it more tightly than single tets.
+  for (const double nu : {0.3, 0.49}) {
+    TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(1, 0.5, 0.4), {4, 2, 2});
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> jitter(-0.03, 0.03);
+    for (Index v = 0; v < mesh.vertices.rows(); ++v)
+      for (int k = 0; k < 3; ++k)
+        mesh.vertices(v, k) += jitter(rng);
+    Material material = beam_material(MaterialModel::neohookean);
+    material.poisson_ratio = nu;
+    const double omega_true = true_max_angular_frequency(mesh, material);
+    const double element = max_angular_frequency_bound(mesh.vertices, mesh.tets, material);
+    const auto grouped = [&](Index size) {
+      std::vector<int> groups(mesh.tets.rows());
+      for (Index t = 0; t < mesh.tets.rows(); ++t)
+        groups[t] = static_cast<int>(t / size);
+      return max_angular_frequency_bound(mesh.vertices, mesh.tets, material, groups);
+    };
+    const double single = grouped(1), sixes = grouped(6), twenty_fours = grouped(24);
+    const double slack = 1e-12 * omega_true;
+    EXPECT_LE(single, element + slack);  // the exact element eigenvalue within its closed form
+    EXPECT_LE(sixes, single + slack);
+    EXPECT_LE(twenty_fours, sixes + slack);
+    EXPECT_GE(twenty_fours, omega_true - slack);
+    EXPECT_LT(twenty_fours, element);  // strictly tighter on these shapes
+    std::printf("nu %.2f: omega bound / true: element %.3f, groups of 1 %.3f, 6 %.3f, 24 %.3f\n",
+                nu, element / omega_true, single / omega_true, sixes / omega_true,
+                twenty_fours / omega_true);
+    // Tets on their own (−1) take the closed form, the others their groups'.
+    std::vector<int> mixed(mesh.tets.rows(), -1);
+    EXPECT_EQ(max_angular_frequency_bound(mesh.vertices, mesh.tets, material, mixed), element);
+    // A mesh of at most 32 tets as one group: its true value, from an assembly of its own.
+    const TetMesh small = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(0.5, 0.25, 0.2), {2, 2, 1});
+    ASSERT_LE(small.tets.rows(), kMaxStabilityGroupTets);
+    const std::vector<int> whole(small.tets.rows(), 7);
+    const double whole_bound =
+        max_angular_frequency_bound(small.vertices, small.tets, material, whole);
+    EXPECT_NEAR(whole_bound, true_max_angular_frequency(small, material), 1e-10 * whole_bound);
+  }
+}
+
+TEST(SimIntegrators, GroupedFrequencyBoundOfARegularTetIsTheClosedForm) {
+  // A regular tet has G Gᵀ ∝ I, and the closed form's two inequalities are equalities there.
+  MatrixX3d x(4, 3);
+  x << 1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1;
+  const MatrixX4i tet = (MatrixX4i(1, 4) << 0, 1, 2, 3).finished();
+  const Material material = beam_material(MaterialModel::stvk);
+  const double closed = max_angular_frequency_bound(x, tet, material);
+  const std::vector<int> own = {0};
+  EXPECT_NEAR(max_angular_frequency_bound(x, tet, material, own), closed, 1e-12 * closed);
+  EXPECT_NEAR(stable_time_step_estimate(x, tet, material, Integrator::rk4, own),
+              2.0 * std::sqrt(2.0) / closed, 1e-12 / closed);
+}
+
+TEST(SimIntegrators, GroupedFrequencyBoundRejectsBadGroups) {
+  const TetMesh mesh = box_tet_mesh(Vector3d(0, 0, 0), Vector3d(1, 1, 1), {2, 2, 2});
+  const Material material = beam_material(MaterialModel::stvk);
+  const std::vector<int> short_list(mesh.tets.rows() - 1, 0);
+  EXPECT_THROW(max_angular_frequency_bound(mesh.vertices, mesh.tets, material, short_list),
+               std::invalid_argument);
+  const std::vector<int> one_group(mesh.tets.rows(), 0);  // 48 tets
+  EXPECT_THROW(max_angular_frequency_bound(mesh.vertices, mesh.tets, material, one_group),
+               std::invalid_argument);
+}
+
 TEST(SimIntegrators, MeanEdgeLengthOfKuhnCubes) {
   // Every tet of a Kuhn-split cube of side h has three edges h, two face diagonals h√2 and one
   // body diagonal h√3. 40 × 40 × 10 cells: 96,000 tets, many blocks of the parallel sum.

@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "adaptive_test_utils.hpp"
 #include "strata/core/common/error.hpp"
 #include "strata/core/mesh/tet_mesh.hpp"
 #include "strata/core/sim/region.hpp"
+#include "strata/core/sim/stable_time_step.hpp"
 #include "strata/hierarchy/adaptive_simulation.hpp"
 #include "strata/hierarchy/finest_level.hpp"
 #include "strata/hierarchy/tree_flatten.hpp"
@@ -502,6 +505,56 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevel
   EXPECT_GE(unstable->cut().finest_level(), 1);
   EXPECT_LT(unstable->cut().size(), slab.coarse.tets.rows() * 64);
   EXPECT_GT(unstable->tolerance_report().refused_refinements, 0);
+}
+
+TEST(AdaptiveSimulation, ExplicitRunsTakeTheStableStepOfSiblingGroups) {
+  // The veto and the full-resolution switch bound the finest level's highest frequency over groups
+  // of eight siblings (stable_time_step.hpp), tighter than the element bound: a dt between the
+  // two refines to the finest level and stays stable there.
+  const PressedSlab slab;
+  const ProblemSpec problem{.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads};
+  SolverSettings settings;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.dt = 1.0;
+  settings.duration = 1.0;
+  const AdaptiveSimulation full(slab.coarse, hierarchy(2, HierarchyMode::full), problem, settings);
+  const TetMesh& finest = full.simulation().mesh();
+  const double element_dt = stable_time_step_estimate(finest.vertices, finest.tets, rubber(),
+                                                      Integrator::symplectic_euler);
+  const double group_dt = full.simulation().stable_dt_estimate();
+  EXPECT_GT(group_dt, 1.3 * element_dt);
+  std::printf("finest level's stable step: groups of siblings %.4g s, tets alone %.4g s (%.3f)\n",
+              group_dt, element_dt, group_dt / element_dt);
+
+  settings.dt = std::sqrt(element_dt * group_dt);
+  settings.duration = 40 * settings.dt;
+  HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
+  h.adapt_every = 1;
+  h.criteria.min_steps_between_changes = 0;
+  h.full_resolution_fraction = 0.02;
+  AdaptiveSimulation sim(slab.coarse, h, problem, settings);
+  run(sim);
+  EXPECT_GE(sim.tolerance_report().full_resolution_step, 0);
+  EXPECT_EQ(sim.cut().size(), finest.tets.rows());
+  EXPECT_EQ(sim.tolerance_report().refused_refinements, 0);
+  EXPECT_GE(sim.simulation().stable_dt_estimate(), settings.dt);
+  // The full-resolution run at that step: 400 steps, no divergence, and the energy within what
+  // the load's work can make it: an undamped oscillator under a step load swings to twice its
+  // static displacement, where kinetic and elastic energy add up to 4 times the static response's
+  // elastic energy (the margin: symplectic Euler's energy error and the material's nonlinearity).
+  SolverSettings long_run = settings;
+  long_run.duration = 400 * settings.dt;
+  AdaptiveSimulation held(slab.coarse, hierarchy(2, HierarchyMode::full), problem, long_run);
+  double largest_energy = 0.0;
+  while (!held.finished()) {
+    ASSERT_NO_THROW(held.advance());
+    largest_energy = std::max(
+        largest_energy, held.simulation().kinetic_energy() + held.simulation().elastic_energy());
+  }
+  AdaptiveSimulation statics(slab.coarse, hierarchy(2, HierarchyMode::full), problem,
+                             static_settings(1));
+  run(statics);
+  EXPECT_LT(largest_energy, 4.5 * statics.simulation().elastic_energy());
 }
 
 TEST(AdaptiveSimulation, RejectsBadSettings) {

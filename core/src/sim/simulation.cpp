@@ -123,6 +123,10 @@ Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& 
         ground_penalty_stiffness(m_material.youngs_modulus, m_embedded->mean_edge_length(),
                                  m_settings.contact.ground_stiffness_factor);
 
+  if (!options.stability_groups.empty() &&
+      static_cast<Index>(options.stability_groups.size()) != m_mesh.tets.rows())
+    throw InputError("simulation: stability_groups must hold one group per tet");
+  m_stability_groups = std::move(options.stability_groups);
   m_first_step = options.first_step;
   m_steps = m_first_step;
   if (!options.nested_spaces.empty()) {
@@ -238,8 +242,8 @@ const MatrixX3i& Simulation::boundary() const {
 
 double Simulation::stable_dt_estimate() const {
   std::call_once(m_stable_dt_once, [&] {
-    m_stable_dt =
-        stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material, m_settings.integrator);
+    m_stable_dt = stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material,
+                                            m_settings.integrator, m_stability_groups);
   });
   return m_stable_dt;
 }

@@ -140,6 +140,14 @@ class SceneSimulation {
                  {binding->barycentric(i, 0), binding->barycentric(i, 1),
                   binding->barycentric(i, 2), binding->barycentric(i, 3)}});
         }
+        const bool box = !scene.mesh.file && !scene.mesh.surface && !scene.mesh.level_set &&
+                         !scene.mesh.implicit;
+        if (box && is_explicit(scene.solver)) {
+          // The stable-step bound over each cell's six tets (box_tet_mesh writes them in a row).
+          options.stability_groups.resize(mesh.tets.rows());
+          for (Index t = 0; t < mesh.tets.rows(); ++t)
+            options.stability_groups[t] = static_cast<int>(t / 6);
+        }
         m_run = std::make_unique<Simulation>(mesh, std::move(problem), scene.solver,
                                              std::move(options));
       }

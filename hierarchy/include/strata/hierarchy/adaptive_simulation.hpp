@@ -29,11 +29,11 @@
 /// the deepest level (the same transfer as any refinement) and the run goes on there without
 /// estimates or cut changes (ToleranceReport::full_resolution_step).
 ///
-/// Explicit integrators: refinement of a node is refused (vetoed) when its children's stable step
-/// estimate (stable_time_step.hpp) falls below the scene's dt; the time step is never changed, so
-/// outputs stay on the scene's time grid. If exact fixed/prescribed regions need such a level, the
-/// construction throws InputError (reduce dt or use implicit Euler); 2:1 balance is refused with
-/// explicit integrators. Implicit integrators and static runs refine freely.
+/// Explicit integrators: refinement of a node is refused (vetoed) when the stable-step bound of its
+/// eight children as one group (stable_time_step.hpp) falls below the scene's dt; the time step is
+/// never changed, so outputs stay on the scene's time grid. If exact fixed/prescribed regions need
+/// such a level, the construction throws InputError (reduce dt or use implicit Euler); 2:1 balance
+/// is refused with explicit integrators. Implicit integrators and static runs refine freely.
 ///
 /// Fixed and prescribed regions stay exact: before the run, active tets on which a group is not
 /// exact are refined until it is, and such parents are never coarsened into (finest_level.hpp).
@@ -332,9 +332,10 @@ class AdaptiveSimulation final : public SimulationRun {
   /// The rest geometry the error estimate reads (recovery_geometry), computed once per cut.
   const RecoveryGeometry* cut_geometry();
   std::optional<RecoveryGeometry> m_cut_geometry;
-  /// Whether solver.dt is within the stable-step estimate of `tets` (Bey-ordered positions) as a
-  /// mesh of their own.
-  bool stable_on_their_own(const std::vector<Matrix3x4d>& tets) const;
+  /// Whether solver.dt is within the stable-step estimate of `groups` of tets (each the eight
+  /// children of one tet, Bey-ordered positions), each group assembled on its own
+  /// (stable_time_step.hpp).
+  bool stable_in_groups(const std::vector<std::array<Matrix3x4d, 8>>& groups) const;
   /// Static runs after a refinement pass re-solved its load step, and a dynamic run's initial
   /// adaptation after its calibration pass: the pass's change (largest vertex displacement
   /// difference between the carried state `carried` and the new equilibrium `solved`, relative
