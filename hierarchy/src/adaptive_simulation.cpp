@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "strata/core/common/error.hpp"
 #include "strata/core/sim/loads.hpp"
@@ -468,43 +470,104 @@ bool AdaptiveSimulation::cut_can_refine() const {
 }
 
 bool AdaptiveSimulation::children_stable(NodeId n) const {
-  // The eight children as a group of their own (stable_time_step.hpp): the group bound holds for
-  // any cut that holds them, whatever their neighbours. The answer holds for the whole run (the
-  // shapes, the material and dt stay), so it is kept per node, by its place in the tree, which
-  // outlives node ids.
+  // The children as a group of their own (stable_time_step.hpp), whatever their neighbours: a cut
+  // holds any of them with their siblings refined further, so every selection of them is bounded.
+  // The answer holds for the whole run (the shapes, the material and dt stay), so it is kept per
+  // node, by its place in the tree, which outlives node ids.
   const std::pair<int, std::uint64_t> path = node_path(n);
   if (const auto known = m_children_stable.find(path); known != m_children_stable.end())
     return known->second;
-  const bool stable = stable_in_groups({red_refine_tet(m_tree->bey_positions(n))});
+  const double omega_squared = sibling_frequency_squared(m_tree->bey_positions(n), 0);
+  const bool stable =
+      explicit_stability_interval(m_solver.integrator) >= m_solver.dt * std::sqrt(omega_squared);
   m_children_stable.emplace(path, stable);
   return stable;
 }
 
-bool AdaptiveSimulation::stable_in_groups(
-    const std::vector<std::array<Matrix3x4d, 8>>& groups) const {
-  // One mesh of the groups, the corners a group's children share merged (a midpoint is the same
-  // sum in every child that holds it).
-  MatrixX3d vertices(32 * static_cast<Index>(groups.size()), 3);
-  MatrixX4i elements(8 * static_cast<Index>(groups.size()), 4);
-  std::vector<int> group_of(8 * groups.size());
-  Index num_vertices = 0;
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const Index first = num_vertices;
-    for (int c = 0; c < 8; ++c) {
-      const Index t = 8 * static_cast<Index>(g) + c;
-      group_of[t] = static_cast<int>(g);
-      for (int k = 0; k < 4; ++k) {
-        const Vector3d x = groups[g][c].col(k);
-        Index v = first;
-        while (v < num_vertices && vertices.row(v) != x.transpose())
-          ++v;
-        if (v == num_vertices) vertices.row(num_vertices++) = x.transpose();
-        elements(t, k) = static_cast<int>(v);
-      }
-    }
+double AdaptiveSimulation::sibling_frequency_squared(const Matrix3x4d& parent,
+                                                     std::uint8_t children) const {
+  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  static constexpr double kKeyScale = 1099511627776.0;  // 2^40
+  static constexpr double kShapeMargin = 1e-9;
+  std::array<double, 6> squared{};
+  for (int e = 0; e < 6; ++e)
+    squared[e] = (parent.col(kEdges[e][0]) - parent.col(kEdges[e][1])).squaredNorm();
+  const double longest = *std::max_element(squared.begin(), squared.end());
+  std::array<std::int64_t, 6> key{};
+  for (int e = 0; e < 6; ++e)
+    key[e] = std::llround(squared[e] / longest * kKeyScale);
+  auto known = m_sibling_frequencies.find(key);
+  if (known == m_sibling_frequencies.end()) {
+    std::array<double, 256> none;
+    none.fill(std::numeric_limits<double>::quiet_NaN());
+    known = m_sibling_frequencies.emplace(key, none).first;
   }
-  return stable_time_step_estimate(vertices.topRows(num_vertices), elements, m_material,
-                                   m_solver.integrator, group_of) >= m_solver.dt;
+  std::array<double, 256>& values = known->second;
+  const std::array<Matrix3x4d, 8> tets = red_refine_tet(parent);
+  const auto compute = [&](unsigned selection) {
+    // The selected children as one mesh, the corners they share merged (a midpoint is the same
+    // sum in every child that holds it).
+    MatrixX3d vertices(32, 3);
+    std::vector<std::array<int, 4>> elements;
+    Index num_vertices = 0;
+    for (int k = 0; k < 8; ++k) {
+      if (!(selection & (1u << k))) continue;
+      std::array<int, 4> element{};
+      for (int i = 0; i < 4; ++i) {
+        const Eigen::RowVector3d x = tets[k].col(i).transpose();
+        Index v = 0;
+        while (v < num_vertices && vertices.row(v) != x)
+          ++v;
+        if (v == num_vertices) vertices.row(num_vertices++) = x;
+        element[i] = static_cast<int>(v);
+      }
+      elements.push_back(element);
+    }
+    MatrixX4i tet_rows(static_cast<Index>(elements.size()), 4);
+    for (Index t = 0; t < tet_rows.rows(); ++t)
+      for (int i = 0; i < 4; ++i)
+        tet_rows(t, i) = elements[t][i];
+    const std::vector<int> one_group(elements.size(), 0);
+    const double omega = max_angular_frequency_bound(vertices.topRows(num_vertices), tet_rows,
+                                                     m_material, one_group);
+    values[selection] = omega * omega * longest;
+  };
+  if (children != 0) {
+    if (std::isnan(values[children])) compute(children);
+  } else if (std::isnan(values[0])) {
+    double largest = 0.0;
+    for (unsigned selection = 1; selection < 256; ++selection) {
+      if (std::isnan(values[selection])) compute(selection);
+      largest = std::max(largest, values[selection]);
+    }
+    values[0] = largest;
+  }
+  return values[children] / longest * (1.0 + kShapeMargin);
+}
+
+double AdaptiveSimulation::cut_max_angular_frequency() const {
+  const FlatTreeMesh& flat = m_constrained->flat;
+  std::unordered_map<NodeId, std::uint8_t> siblings;  // parent: its children in the cut
+  std::vector<Index> roots;
+  for (std::size_t t = 0; t < flat.tet_nodes.size(); ++t) {
+    const NodeId n = flat.tet_nodes[t];
+    const NodeId parent = m_tree->parent(n);
+    if (parent == kNoNode)
+      roots.push_back(static_cast<Index>(t));
+    else
+      siblings[parent] |= static_cast<std::uint8_t>(1u << m_tree->node(n).child_slot);
+  }
+  double largest = 0.0;
+  for (const auto& [parent, children] : siblings)
+    largest = std::max(largest, sibling_frequency_squared(m_tree->bey_positions(parent), children));
+  if (!roots.empty()) {
+    MatrixX4i root_tets(static_cast<Index>(roots.size()), 4);
+    for (std::size_t r = 0; r < roots.size(); ++r)
+      root_tets.row(static_cast<Index>(r)) = flat.mesh.tets.row(roots[r]);
+    const double omega = max_angular_frequency_bound(flat.mesh.vertices, root_tets, m_material);
+    largest = std::max(largest, omega * omega);
+  }
+  return std::sqrt(largest);
 }
 
 SimulationOptions AdaptiveSimulation::flatten(long first_step) {
@@ -520,13 +583,8 @@ SimulationOptions AdaptiveSimulation::flatten(long first_step) {
   options.extra_mesh_forces = map_point_loads(*m_cut, flat, m_point_loads, &m_load_traction);
   options.first_step = first_step;
   options.nested_spaces = cut_nested_spaces(m_cut->tree(), *m_constrained);
-  if (is_explicit(m_solver)) {
-    // The stable-step estimate over groups of siblings, as the refinement veto takes it; a root
-    // on its own.
-    options.stability_groups.resize(flat.tet_nodes.size());
-    for (std::size_t t = 0; t < flat.tet_nodes.size(); ++t)
-      options.stability_groups[t] = m_tree->parent(flat.tet_nodes[t]);
-  }
+  // The stable-step estimate over groups of siblings, as the refinement veto takes it.
+  if (is_explicit(m_solver)) options.max_angular_frequency = cut_max_angular_frequency();
   add_contact(options);
   // The criteria see every load at its peak.
   for (const auto& [amplitude, point_loads] : m_timed_point_loads) {
@@ -956,18 +1014,24 @@ bool AdaptiveSimulation::past_full_resolution_fraction() const {
       potential_leaf_count(static_cast<std::uint64_t>(m_tree->num_roots()), m_tree->max_level()));
   const Index budget = m_settings.criteria.max_active_elements;
   if (budget > 0 && static_cast<double>(budget) < finest) return false;
-  return static_cast<double>(m_cut->size()) > m_settings.full_resolution_fraction * finest &&
+  return static_cast<double>(m_cut->size()) > full_resolution_fraction() * finest &&
          (!is_explicit(m_solver) || finest_level_stable());
+}
+
+double AdaptiveSimulation::full_resolution_fraction() const {
+  const double set = m_settings.full_resolution_fraction;
+  const StepperTraits& stepper = find_stepper(m_solver);
+  if (!stepper.is_explicit || set >= 1.0) return set;
+  const double evaluations = stepper.force_evaluations;
+  return std::min(set, evaluations / (evaluations + kExplicitEstimateCost));
 }
 
 bool AdaptiveSimulation::finest_level_stable() const {
   if (!m_finest_level_stable) {
     // The bound over groups (stable_time_step.hpp): the finest level's tets in groups of eight
-    // siblings, root by root.
+    // siblings, root by root; a tree of one level, its roots on their own.
     bool stable = true;
-    std::vector<Matrix3x4d> tets, children;
-    std::vector<std::array<Matrix3x4d, 8>> groups;
-    if (m_tree->max_level() == 0) {  // the roots, each on its own
+    if (m_tree->max_level() == 0) {
       MatrixX3d vertices(4 * m_tree->num_roots(), 3);
       MatrixX4i elements(m_tree->num_roots(), 4);
       for (NodeId root = 0; root < m_tree->num_roots(); ++root)
@@ -978,6 +1042,8 @@ bool AdaptiveSimulation::finest_level_stable() const {
       stable = stable_time_step_estimate(vertices, elements, m_material, m_solver.integrator) >=
                m_solver.dt;
     }
+    const double interval = explicit_stability_interval(m_solver.integrator);
+    std::vector<Matrix3x4d> tets, children;
     for (NodeId root = 0; root < m_tree->num_roots() && stable && m_tree->max_level() > 0; ++root) {
       tets.assign(1, m_tree->bey_positions(root));
       for (int level = 0; level + 1 < m_tree->max_level(); ++level) {
@@ -987,10 +1053,8 @@ bool AdaptiveSimulation::finest_level_stable() const {
             children.push_back(child);
         tets.swap(children);
       }
-      groups.clear();
       for (const Matrix3x4d& x : tets)
-        groups.push_back(red_refine_tet(x));
-      stable = stable_in_groups(groups);
+        stable = stable && interval >= m_solver.dt * std::sqrt(sibling_frequency_squared(x, 0xFF));
     }
     m_finest_level_stable = stable;
   }

@@ -523,6 +523,13 @@ TEST(AdaptiveSimulation, ExplicitRunsTakeTheStableStepOfSiblingGroups) {
                                                       Integrator::symplectic_euler);
   const double group_dt = full.simulation().stable_dt_estimate();
   EXPECT_GT(group_dt, 1.3 * element_dt);
+  // The same bound from every sibling group's own eigen-solve (the run keeps them by shape).
+  std::vector<int> parents(full.flat().tet_nodes.size());
+  for (std::size_t t = 0; t < parents.size(); ++t)
+    parents[t] = full.tree().parent(full.flat().tet_nodes[t]);
+  const double direct_dt = stable_time_step_estimate(finest.vertices, finest.tets, rubber(),
+                                                     Integrator::symplectic_euler, parents);
+  EXPECT_NEAR(group_dt, direct_dt, 1e-8 * direct_dt);
   std::printf("finest level's stable step: groups of siblings %.4g s, tets alone %.4g s (%.3f)\n",
               group_dt, element_dt, group_dt / element_dt);
 
@@ -555,6 +562,59 @@ TEST(AdaptiveSimulation, ExplicitRunsTakeTheStableStepOfSiblingGroups) {
                              static_settings(1));
   run(statics);
   EXPECT_LT(largest_energy, 4.5 * statics.simulation().elastic_energy());
+}
+
+TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionWhereAnAdaptiveStepCostsMore) {
+  // An explicit step costs f force evaluations per tet (1 symplectic Euler, 4 RK4), an adaptive
+  // step also the decision's estimate, about kExplicitEstimateCost of them: past f / (f + cost) of
+  // the finest level's tets full resolution is cheaper.
+  const PressedSlab slab;
+  const ProblemSpec problem{.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads};
+  SolverSettings settings;
+  settings.integrator = Integrator::symplectic_euler;
+  settings.dt = 1.0;
+  settings.duration = 1.0;
+  const double finest_dt =
+      AdaptiveSimulation(slab.coarse, hierarchy(2, HierarchyMode::full), problem, settings)
+          .simulation()
+          .stable_dt_estimate();
+  settings.dt = 0.5 * finest_dt;
+  settings.duration = 10 * settings.dt;
+  const double cost = AdaptiveSimulation::kExplicitEstimateCost;
+  HierarchySettings h;
+  h.levels = 2;
+  h.tolerance = 0.05;
+  const auto fraction = [&](Integrator integrator, double set) {
+    SolverSettings s = settings;
+    s.integrator = integrator;
+    HierarchySettings with = h;
+    with.full_resolution_fraction = set;
+    return AdaptiveSimulation(slab.coarse, with, problem, s).full_resolution_fraction();
+  };
+  EXPECT_DOUBLE_EQ(fraction(Integrator::symplectic_euler, 0.75), 1.0 / (1.0 + cost));
+  EXPECT_DOUBLE_EQ(fraction(Integrator::rk4, 0.75), 4.0 / (4.0 + cost));
+  EXPECT_DOUBLE_EQ(fraction(Integrator::symplectic_euler, 0.05), 0.05);
+  EXPECT_DOUBLE_EQ(fraction(Integrator::symplectic_euler, 1.0), 1.0);  // never
+  EXPECT_DOUBLE_EQ(fraction(Integrator::implicit_euler, 0.75), 0.75);
+  // The slab's first cut lies between the explicit share and the default 0.75: never sent to full
+  // resolution it stays adaptive, by default it goes on at full resolution before its first step.
+  const Index finest = slab.coarse.tets.rows() * 64;
+  h.full_resolution_fraction = 1.0;
+  AdaptiveSimulation kept(slab.coarse, h, problem, settings);
+  const double share = static_cast<double>(kept.cut().size()) / static_cast<double>(finest);
+  ASSERT_GT(share, 1.0 / (1.0 + cost));
+  ASSERT_LT(share, 0.75);
+  h.full_resolution_fraction = 0.75;
+  AdaptiveSimulation sim(slab.coarse, h, problem, settings);
+  EXPECT_EQ(sim.tolerance_report().full_resolution_step, 0);
+  EXPECT_EQ(sim.cut().size(), finest);
+  run(sim);
+  // Backward Euler keeps the same first cut adaptive.
+  SolverSettings implicit = settings;
+  implicit.integrator = Integrator::implicit_euler;
+  const AdaptiveSimulation implicit_run(slab.coarse, h, problem, implicit);
+  EXPECT_EQ(implicit_run.tolerance_report().full_resolution_step, -1);
+  EXPECT_LT(implicit_run.cut().size(), finest);
 }
 
 TEST(AdaptiveSimulation, RejectsBadSettings) {

@@ -123,10 +123,9 @@ Simulation::Simulation(TetMesh mesh, ProblemSpec problem, const SolverSettings& 
         ground_penalty_stiffness(m_material.youngs_modulus, m_embedded->mean_edge_length(),
                                  m_settings.contact.ground_stiffness_factor);
 
-  if (!options.stability_groups.empty() &&
-      static_cast<Index>(options.stability_groups.size()) != m_mesh.tets.rows())
-    throw InputError("simulation: stability_groups must hold one group per tet");
-  m_stability_groups = std::move(options.stability_groups);
+  if (!(options.max_angular_frequency >= 0.0) || !std::isfinite(options.max_angular_frequency))
+    throw InputError("simulation: max_angular_frequency must be finite and >= 0");
+  m_max_angular_frequency = options.max_angular_frequency;
   m_first_step = options.first_step;
   m_steps = m_first_step;
   if (!options.nested_spaces.empty()) {
@@ -242,8 +241,10 @@ const MatrixX3i& Simulation::boundary() const {
 
 double Simulation::stable_dt_estimate() const {
   std::call_once(m_stable_dt_once, [&] {
-    m_stable_dt = stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material,
-                                            m_settings.integrator, m_stability_groups);
+    m_stable_dt = m_max_angular_frequency > 0.0
+                      ? explicit_stability_interval(m_settings.integrator) / m_max_angular_frequency
+                      : stable_time_step_estimate(m_mesh.vertices, m_mesh.tets, m_material,
+                                                  m_settings.integrator);
   });
   return m_stable_dt;
 }

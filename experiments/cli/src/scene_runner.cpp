@@ -143,10 +143,11 @@ class SceneSimulation {
         const bool box = !scene.mesh.file && !scene.mesh.surface && !scene.mesh.level_set &&
                          !scene.mesh.implicit;
         if (box && is_explicit(scene.solver)) {
-          // The stable-step bound over each cell's six tets (box_tet_mesh writes them in a row).
-          options.stability_groups.resize(mesh.tets.rows());
-          for (Index t = 0; t < mesh.tets.rows(); ++t)
-            options.stability_groups[t] = static_cast<int>(t / 6);
+          // The stable-step bound over each cell's six tets (stable_time_step.hpp): the cells of
+          // a box are congruent (mirror images), and box_tet_mesh writes a cell's tets in a row.
+          const MatrixX4i cell = mesh.tets.topRows(6);
+          options.max_angular_frequency = max_angular_frequency_bound(
+              mesh.vertices, cell, scene.material, std::vector<int>(6, 0));
         }
         m_run = std::make_unique<Simulation>(mesh, std::move(problem), scene.solver,
                                              std::move(options));
@@ -260,6 +261,7 @@ nlohmann::json hierarchy_json(const AdaptiveSimulation& adaptive, bool finished)
   block["initial_newton_iterations"] = report.initial_newton_iterations;
   block["initial_adaptation_seconds"] = report.initial_adaptation_seconds;
   block["full_resolution_fraction"] = settings.full_resolution_fraction;
+  block["full_resolution_fraction_in_use"] = adaptive.full_resolution_fraction();
   block["coarsen_budget"] = settings.coarsen_budget;
   if (report.full_resolution_step >= 0) {
     block["full_resolution_step"] = report.full_resolution_step;
@@ -680,10 +682,17 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options) {
   if (const AdaptiveSimulation* adaptive = scene_simulation.adaptive();
       adaptive && !options.quiet && adaptive->tolerance_report().full_resolution_step >= 0) {
     const long step = adaptive->tolerance_report().full_resolution_step;
+    const bool explicit_limit =
+        adaptive->full_resolution_fraction() < adaptive->settings().full_resolution_fraction;
     log << "strata: the cut would have held more than "
-        << 100.0 * adaptive->settings().full_resolution_fraction << " % of the finest level's tets "
+        << 100.0 * adaptive->full_resolution_fraction() << " % of the finest level's tets "
         << (step == 0 ? std::string("before the first step") : "after step " + std::to_string(step))
-        << ": the run went on at full resolution (hierarchy.full_resolution_fraction)\n";
+        << ": the run went on at full resolution ("
+        << (explicit_limit
+                ? std::string("beyond this share an adaptive step of ") +
+                      to_string(scene.solver.integrator) + " costs more than a full-resolution one"
+                : std::string("hierarchy.full_resolution_fraction"))
+        << ")\n";
   }
   if (!options.quiet) {
     log << "strata: done: " << summary.steps << " steps, " << summary.frames << " frames in "

@@ -13,13 +13,13 @@ NewtonResult TimeStepper::resolve(double, VectorXd&, VectorXd&, const VectorXd&)
 
 const std::vector<StepperTraits>& stepper_registry() {
   static const std::vector<StepperTraits> registry = {
-      {"static", SimulationMode::static_equilibrium, Integrator::implicit_euler, false,
+      {"static", SimulationMode::static_equilibrium, Integrator::implicit_euler, false, 0,
        &make_static_load_stepper},
-      {"implicit_euler", SimulationMode::dynamic, Integrator::implicit_euler, false,
+      {"implicit_euler", SimulationMode::dynamic, Integrator::implicit_euler, false, 0,
        &make_backward_euler_stepper},
-      {"symplectic_euler", SimulationMode::dynamic, Integrator::symplectic_euler, true,
+      {"symplectic_euler", SimulationMode::dynamic, Integrator::symplectic_euler, true, 1,
        &make_symplectic_euler_stepper},
-      {"rk4", SimulationMode::dynamic, Integrator::rk4, true, &make_rk4_stepper},
+      {"rk4", SimulationMode::dynamic, Integrator::rk4, true, 4, &make_rk4_stepper},
   };
   return registry;
 }

@@ -46,6 +46,8 @@
 /// shifted to keep ½ Σ m v² and the momentum exactly; when prescribed vertices took over mass from
 /// the region (coarser cuts lump more mass onto them), both cannot hold and the kinetic energy is
 /// kept with the momentum's direction (a cut change never adds kinetic energy).
+#include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -97,7 +99,8 @@ struct HierarchySettings {
   /// no more estimates or cut changes): a cut that large costs more than full resolution (hanging
   /// vertices, estimates, redone steps and cut changes; README, "Error control"). 1: never.
   /// Not with an element budget below the finest level, max_level below the tree's depth, or an
-  /// explicit integrator whose dt exceeds the finest level's stable-step estimate.
+  /// explicit integrator whose dt exceeds the finest level's stable-step estimate. Explicit
+  /// integrators take at most AdaptiveSimulation::full_resolution_fraction()'s share.
   double full_resolution_fraction = 0.75;
   /// With the recovery estimate (an error-estimating indicator): the merges of one change are
   /// kept to those whose predicted estimate stays within coarsen_budget · tolerance
@@ -258,6 +261,15 @@ class AdaptiveSimulation final : public SimulationRun {
   /// The current cut as a mesh, with its tree maps.
   const FlatTreeMesh& flat() const { return m_constrained->flat; }
   const HangingConstraints& constraints() const { return m_constrained->constraints; }
+  /// The share of the finest level's tets past which a refinement takes the run to full
+  /// resolution: HierarchySettings::full_resolution_fraction, and with an explicit integrator at
+  /// most f / (f + kExplicitEstimateCost) for its f force evaluations per step (1/5 symplectic
+  /// Euler, 1/2 RK4): past it an adaptive step costs more than a step at full resolution.
+  double full_resolution_fraction() const;
+  /// What an explicit run's per-step decision (strains, recovered strains, the estimate's terms)
+  /// costs per active tet, in internal-force evaluations per tet: 3–6 measured on 2k–16k-tet cuts
+  /// of the project's scenes (README, "Error control").
+  static constexpr double kExplicitEstimateCost = 4.0;
   /// Tree level of each active tet (#T of flat().mesh).
   VectorXi cell_levels() const;
   const HierarchySettings& settings() const { return m_settings; }
@@ -332,10 +344,19 @@ class AdaptiveSimulation final : public SimulationRun {
   /// The rest geometry the error estimate reads (recovery_geometry), computed once per cut.
   const RecoveryGeometry* cut_geometry();
   std::optional<RecoveryGeometry> m_cut_geometry;
-  /// Whether solver.dt is within the stable-step estimate of `groups` of tets (each the eight
-  /// children of one tet, Bey-ordered positions), each group assembled on its own
-  /// (stable_time_step.hpp).
-  bool stable_in_groups(const std::vector<std::array<Matrix3x4d, 8>>& groups) const;
+  /// The bound on ω² of the children of a tet at `parent` (Bey-ordered positions) that
+  /// `children` selects (bit k: child slot k; 0: the largest over every non-empty selection),
+  /// assembled as one group (stable_time_step.hpp). Kept by the parent's shape (its edges' squared
+  /// lengths relative to the longest, to 2⁻⁴⁰; ω² scales as the inverse square of the size), with
+  /// a relative margin of 1e-9 for shapes that share a key: the tree's tets fall into a few shapes
+  /// (Bey's refinement makes at most three similarity classes per root), so the bound of a whole
+  /// level costs a few eigen-solves.
+  double sibling_frequency_squared(const Matrix3x4d& parent, std::uint8_t children) const;
+  /// Per parent shape: ω² × the longest squared edge, per selection of children (NaN: not yet
+  /// computed; entry 0: the largest over the selections).
+  mutable std::map<std::array<std::int64_t, 6>, std::array<double, 256>> m_sibling_frequencies;
+  /// The bound on ω_max of the current cut: its tets grouped by parent, a root on its own.
+  double cut_max_angular_frequency() const;
   /// Static runs after a refinement pass re-solved its load step, and a dynamic run's initial
   /// adaptation after its calibration pass: the pass's change (largest vertex displacement
   /// difference between the carried state `carried` and the new equilibrium `solved`, relative

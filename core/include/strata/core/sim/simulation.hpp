@@ -111,10 +111,10 @@ struct SimulationOptions {
   /// Barrier stiffness κ [N/m] of the obstacles; 0: E × this mesh's mean edge length. A driver
   /// that runs one scene on several meshes (the hierarchy's cuts) fixes it for all of them.
   double contact_stiffness = 0.0;
-  /// Groups of tets for stable_dt_estimate (one id ≥ 0 per group, −1 for a tet on its own, at
-  /// most kMaxStabilityGroupTets per group; stable_time_step.hpp), e.g. the hierarchy's sibling
-  /// tets; empty: every tet on its own.
-  std::vector<int> stability_groups;
+  /// A bound on the highest angular frequency of the system linearised at rest [rad/s] that the
+  /// driver computed, for stable_dt_estimate: over groups of tets (stable_time_step.hpp), e.g.
+  /// the hierarchy's sibling tets or a box mesh's cells; 0: the element bound of this mesh.
+  double max_angular_frequency = 0.0;
 };
 
 /// Work counters of this Simulation object (not including steps before `first_step`).
@@ -197,8 +197,8 @@ class Simulation final : public SimulationRun {
   long step_count() const { return m_steps; }
 
   /// Largest stable step of the chosen integrator [s], a guaranteed bound for the problem
-  /// linearised at rest (stable_time_step.hpp), over SimulationOptions::stability_groups;
-  /// reported, never applied. Computed on first use.
+  /// linearised at rest (stable_time_step.hpp): from SimulationOptions::max_angular_frequency,
+  /// or the element bound; reported, never applied. Computed on first use.
   double stable_dt_estimate() const;
 
   std::vector<GroupReaction> reactions() const;
@@ -327,7 +327,7 @@ class Simulation final : public SimulationRun {
   double m_diagonal = 0.0;
   mutable std::once_flag m_stable_dt_once;
   mutable double m_stable_dt = 0.0;
-  std::vector<int> m_stability_groups;  ///< SimulationOptions::stability_groups
+  double m_max_angular_frequency = 0.0;  ///< SimulationOptions::max_angular_frequency
   DivergenceLimits m_limits;
   NestedSpaces m_nested;
   std::vector<SmootherEstimate> m_smoother_seed;  ///< SimulationOptions::smoother_estimates

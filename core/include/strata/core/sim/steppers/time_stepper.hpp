@@ -55,6 +55,9 @@ struct StepperTraits {
   SimulationMode mode;    ///< static load stepping or time integration
   Integrator integrator;  ///< dynamic steppers: the scene's solver.integrator
   bool is_explicit;       ///< conditionally stable (dt below the stable estimate)
+  /// Explicit steppers: internal-force evaluations per step (1 symplectic Euler, 4 RK4); 0 for
+  /// the implicit ones, whose Newton iterations vary.
+  int force_evaluations;
   std::unique_ptr<TimeStepper> (*make)(const Problem& problem, const SolverSettings& settings);
 };
 
