@@ -829,6 +829,13 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   const bool within_tolerance = calibration_target <= 0.0 && m_estimates_error &&
                                 scale * m_estimate.relative_error <= m_settings.tolerance;
   if (calibration_target > 0.0) state.tolerance_scale = m_settings.tolerance / calibration_target;
+  const std::vector<NodeId> contact =
+      refine ? explicit_contact_refinements() : std::vector<NodeId>();
+  if (!coarsen && !contact.empty() && (!refine || within_tolerance)) {
+    CutChanges changes;
+    changes.refine = contact;
+    return changes;
+  }
   if (!coarsen && (!refine || within_tolerance)) return {};
   // A cut none of whose tets may refine (max_level, the explicit step limit) asks the controller
   // for nothing it could do; the step is counted instead.
@@ -853,7 +860,34 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   } else {
     m_report.refused_refinements += changes.refused;
   }
+  for (const NodeId n : contact)
+    if (std::find(changes.refine.begin(), changes.refine.end(), n) == changes.refine.end())
+      changes.refine.push_back(n);
+  // A merge of a node refined now would undo it.
+  if (!contact.empty())
+    std::erase_if(changes.coarsen, [&](NodeId parent) {
+      return std::any_of(contact.begin(), contact.end(),
+                         [&](NodeId n) { return m_tree->parent(n) == parent; });
+    });
   return changes;
+}
+
+std::vector<NodeId> AdaptiveSimulation::explicit_contact_refinements() {
+  // The explicit integrators' contact is a projection that stops each contact vertex: the kinetic
+  // energy it removes is that of the vertex's lumped mass, which on a coarse tet is a coarse
+  // share of the body. The tets in contact (criteria_loads) go to the finest level the veto
+  // allows, as the full-resolution run meets the obstacle with its own fine masses.
+  std::vector<NodeId> nodes;
+  if (!is_explicit(m_solver) || m_in_contact.empty()) return nodes;
+  const int deepest = max_refine_level();
+  for (const NodeId n : m_constrained->flat.tet_nodes)
+    if (m_in_contact.contains(n) && m_tree->level(n) < deepest) {
+      if (children_stable(n))
+        nodes.push_back(n);
+      else
+        ++m_report.refused_refinements;
+    }
+  return nodes;
 }
 
 bool AdaptiveSimulation::adapt(int pass, bool refine, bool coarsen, double calibration_target) {

@@ -355,6 +355,10 @@ class AdaptiveSimulation final : public SimulationRun {
   /// Per parent shape: ω² × the longest squared edge, per selection of children (NaN: not yet
   /// computed; entry 0: the largest over the selections).
   mutable std::map<std::array<std::int64_t, 6>, std::array<double, 256>> m_sibling_frequencies;
+  /// Explicit integrators: the active tets in contact (m_in_contact, as criteria_loads found it)
+  /// below the deepest level whose children are stable: refined at once, the estimate aside (the
+  /// others counted as refused refinements).
+  std::vector<NodeId> explicit_contact_refinements();
   /// The bound on ω_max of the current cut: its tets grouped by parent, a root on its own.
   double cut_max_angular_frequency() const;
   /// Static runs after a refinement pass re-solved its load step, and a dynamic run's initial
