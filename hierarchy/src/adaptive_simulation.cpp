@@ -503,8 +503,9 @@ double AdaptiveSimulation::sibling_frequency_squared(const Matrix3x4d& parent,
     known = m_sibling_frequencies.emplace(key, none).first;
   }
   std::array<double, 256>& values = known->second;
-  const std::array<Matrix3x4d, 8> tets = red_refine_tet(parent);
+  std::optional<std::array<Matrix3x4d, 8>> tets;
   const auto compute = [&](unsigned selection) {
+    if (!tets) tets = red_refine_tet(parent);
     // The selected children as one mesh, the corners they share merged (a midpoint is the same
     // sum in every child that holds it).
     MatrixX3d vertices(32, 3);
@@ -514,7 +515,7 @@ double AdaptiveSimulation::sibling_frequency_squared(const Matrix3x4d& parent,
       if (!(selection & (1u << k))) continue;
       std::array<int, 4> element{};
       for (int i = 0; i < 4; ++i) {
-        const Eigen::RowVector3d x = tets[k].col(i).transpose();
+        const Eigen::RowVector3d x = (*tets)[k].col(i).transpose();
         Index v = 0;
         while (v < num_vertices && vertices.row(v) != x)
           ++v;
@@ -535,8 +536,11 @@ double AdaptiveSimulation::sibling_frequency_squared(const Matrix3x4d& parent,
   if (children != 0) {
     if (std::isnan(values[children])) compute(children);
   } else if (std::isnan(values[0])) {
+    // The largest over every selection is the largest over the single children: a selection is
+    // bounded by its tets alone (the partition bound), and the single children are selections.
     double largest = 0.0;
-    for (unsigned selection = 1; selection < 256; ++selection) {
+    for (int k = 0; k < 8; ++k) {
+      const unsigned selection = 1u << k;
       if (std::isnan(values[selection])) compute(selection);
       largest = std::max(largest, values[selection]);
     }
@@ -863,16 +867,10 @@ CutChanges AdaptiveSimulation::decide(bool refine, bool coarsen, double calibrat
   for (const NodeId n : contact)
     if (std::find(changes.refine.begin(), changes.refine.end(), n) == changes.refine.end())
       changes.refine.push_back(n);
-  // A merge of a node refined now would undo it.
-  if (!contact.empty())
-    std::erase_if(changes.coarsen, [&](NodeId parent) {
-      return std::any_of(contact.begin(), contact.end(),
-                         [&](NodeId n) { return m_tree->parent(n) == parent; });
-    });
   return changes;
 }
 
-std::vector<NodeId> AdaptiveSimulation::explicit_contact_refinements() {
+std::vector<NodeId> AdaptiveSimulation::explicit_contact_refinements() const {
   // The explicit integrators' contact is a projection that stops each contact vertex: the kinetic
   // energy it removes is that of the vertex's lumped mass, which on a coarse tet is a coarse
   // share of the body. The tets in contact (criteria_loads) go to the finest level the veto
@@ -880,12 +878,13 @@ std::vector<NodeId> AdaptiveSimulation::explicit_contact_refinements() {
   std::vector<NodeId> nodes;
   if (!is_explicit(m_solver) || m_in_contact.empty()) return nodes;
   const int deepest = max_refine_level();
+  const Index budget = m_settings.criteria.max_active_elements;
+  Index size = m_cut->size();
   for (const NodeId n : m_constrained->flat.tet_nodes)
-    if (m_in_contact.contains(n) && m_tree->level(n) < deepest) {
-      if (children_stable(n))
-        nodes.push_back(n);
-      else
-        ++m_report.refused_refinements;
+    if (m_in_contact.contains(n) && m_tree->level(n) < deepest && children_stable(n) &&
+        (budget <= 0 || size + 7 <= budget)) {
+      nodes.push_back(n);
+      size += 7;
     }
   return nodes;
 }

@@ -345,7 +345,8 @@ class AdaptiveSimulation final : public SimulationRun {
   const RecoveryGeometry* cut_geometry();
   std::optional<RecoveryGeometry> m_cut_geometry;
   /// The bound on ω² of the children of a tet at `parent` (Bey-ordered positions) that
-  /// `children` selects (bit k: child slot k; 0: the largest over every non-empty selection),
+  /// `children` selects (bit k: child slot k; 0: the largest over every non-empty selection, which
+  /// is the largest single child's),
   /// assembled as one group (stable_time_step.hpp). Kept by the parent's shape (its edges' squared
   /// lengths relative to the longest, to 2⁻⁴⁰; ω² scales as the inverse square of the size), with
   /// a relative margin of 1e-9 for shapes that share a key: the tree's tets fall into a few shapes
@@ -356,9 +357,10 @@ class AdaptiveSimulation final : public SimulationRun {
   /// computed; entry 0: the largest over the selections).
   mutable std::map<std::array<std::int64_t, 6>, std::array<double, 256>> m_sibling_frequencies;
   /// Explicit integrators: the active tets in contact (m_in_contact, as criteria_loads found it)
-  /// below the deepest level whose children are stable: refined at once, the estimate aside (the
-  /// others counted as refused refinements).
-  std::vector<NodeId> explicit_contact_refinements();
+  /// below the deepest level whose children are stable, within max_active_elements: refined at
+  /// once, the estimate aside. Their parents are not merged meanwhile (the coarsening veto holds
+  /// nodes in contact).
+  std::vector<NodeId> explicit_contact_refinements() const;
   /// The bound on ω_max of the current cut: its tets grouped by parent, a root on its own.
   double cut_max_angular_frequency() const;
   /// Static runs after a refinement pass re-solved its load step, and a dynamic run's initial
