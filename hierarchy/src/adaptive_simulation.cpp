@@ -486,12 +486,11 @@ bool AdaptiveSimulation::children_stable(NodeId n) const {
 
 double AdaptiveSimulation::sibling_frequency_squared(const Matrix3x4d& parent,
                                                      std::uint8_t children) const {
-  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   static constexpr double kKeyScale = 1099511627776.0;  // 2^40
   static constexpr double kShapeMargin = 1e-9;
   std::array<double, 6> squared{};
   for (int e = 0; e < 6; ++e)
-    squared[e] = (parent.col(kEdges[e][0]) - parent.col(kEdges[e][1])).squaredNorm();
+    squared[e] = (parent.col(kTetEdges[e][0]) - parent.col(kTetEdges[e][1])).squaredNorm();
   const double longest = *std::max_element(squared.begin(), squared.end());
   std::array<std::int64_t, 6> key{};
   for (int e = 0; e < 6; ++e)

@@ -226,6 +226,16 @@ struct PressedSlab {
       box_load(Vector3d(0.4, 0.4, 0.25), Vector3d(0.6, 0.6, 0.25), Vector3d(0, 0, -500.0))};
   MatrixX3d probe = (MatrixX3d(1, 3) << 0.5, 0.5, 0.25).finished();
 
+  ProblemSpec problem() const { return {.material = rubber(), .dirichlet = fixed, .loads = loads}; }
+  /// The symplectic-Euler stable-step estimate of the finest level of `levels`.
+  double finest_explicit_dt(int levels) const {
+    SolverSettings settings;
+    settings.integrator = Integrator::symplectic_euler;
+    return AdaptiveSimulation(coarse, hierarchy(levels, HierarchyMode::full), problem(), settings)
+        .simulation()
+        .stable_dt_estimate();
+  }
+
   double probe_uz(const HierarchySettings& settings, Index* tets) const {
     AdaptiveSimulation sim(coarse, settings,
                            {.material = rubber(), .dirichlet = fixed, .loads = loads},
@@ -472,15 +482,7 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevel
   const PressedSlab slab;
   SolverSettings settings;
   settings.integrator = Integrator::symplectic_euler;
-  settings.dt = 1.0;
-  settings.duration = 1.0;
-  HierarchySettings full = hierarchy(2, HierarchyMode::full);
-  const double finest_dt =
-      AdaptiveSimulation(slab.coarse, full,
-                         {.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads},
-                         settings)
-          .simulation()
-          .stable_dt_estimate();
+  const double finest_dt = slab.finest_explicit_dt(2);
   HierarchySettings h = hierarchy(2, HierarchyMode::adaptive, 0);
   h.adapt_every = 1;
   h.criteria.min_steps_between_changes = 0;
@@ -488,9 +490,7 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionOnlyWhereTheFinestLevel
   const auto run_at = [&](double dt) {
     settings.dt = dt;
     settings.duration = 20 * dt;
-    auto sim = std::make_unique<AdaptiveSimulation>(
-        slab.coarse, h,
-        ProblemSpec{.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads}, settings);
+    auto sim = std::make_unique<AdaptiveSimulation>(slab.coarse, h, slab.problem(), settings);
     run(*sim);
     return sim;
   };
@@ -512,11 +512,9 @@ TEST(AdaptiveSimulation, ExplicitRunsTakeTheStableStepOfSiblingGroups) {
   // of eight siblings (stable_time_step.hpp), tighter than the element bound: a dt between the
   // two refines to the finest level and stays stable there.
   const PressedSlab slab;
-  const ProblemSpec problem{.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads};
+  const ProblemSpec problem = slab.problem();
   SolverSettings settings;
   settings.integrator = Integrator::symplectic_euler;
-  settings.dt = 1.0;
-  settings.duration = 1.0;
   const AdaptiveSimulation full(slab.coarse, hierarchy(2, HierarchyMode::full), problem, settings);
   const TetMesh& finest = full.simulation().mesh();
   const double element_dt = stable_time_step_estimate(finest.vertices, finest.tets, rubber(),
@@ -569,16 +567,10 @@ TEST(AdaptiveSimulation, ExplicitRunsGoOnAtFullResolutionWhereAnAdaptiveStepCost
   // step also the decision's estimate, about kExplicitEstimateCost of them: past f / (f + cost) of
   // the finest level's tets full resolution is cheaper.
   const PressedSlab slab;
-  const ProblemSpec problem{.material = rubber(), .dirichlet = slab.fixed, .loads = slab.loads};
+  const ProblemSpec problem = slab.problem();
   SolverSettings settings;
   settings.integrator = Integrator::symplectic_euler;
-  settings.dt = 1.0;
-  settings.duration = 1.0;
-  const double finest_dt =
-      AdaptiveSimulation(slab.coarse, hierarchy(2, HierarchyMode::full), problem, settings)
-          .simulation()
-          .stable_dt_estimate();
-  settings.dt = 0.5 * finest_dt;
+  settings.dt = 0.5 * slab.finest_explicit_dt(2);
   settings.duration = 10 * settings.dt;
   const double cost = AdaptiveSimulation::kExplicitEstimateCost;
   HierarchySettings h;

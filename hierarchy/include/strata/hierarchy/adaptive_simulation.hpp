@@ -29,9 +29,11 @@
 /// the deepest level (the same transfer as any refinement) and the run goes on there without
 /// estimates or cut changes (ToleranceReport::full_resolution_step).
 ///
-/// Explicit integrators: refinement of a node is refused (vetoed) when the stable-step bound of its
-/// eight children as one group (stable_time_step.hpp) falls below the scene's dt; the time step is
-/// never changed, so outputs stay on the scene's time grid. If exact fixed/prescribed regions need
+/// Explicit integrators: refinement of a node is refused (vetoed) when the stable-step bound of
+/// its children (any selection of them as one group, stable_time_step.hpp) falls below the scene's
+/// dt; the time step is never changed, so outputs stay on the scene's time grid. Past
+/// full_resolution_fraction()'s share they go on at full resolution, and the tets in contact are
+/// refined to the finest level in the step they touch. If exact fixed/prescribed regions need
 /// such a level, the construction throws InputError (reduce dt or use implicit Euler); 2:1 balance
 /// is refused with explicit integrators. Implicit integrators and static runs refine freely.
 ///
@@ -344,14 +346,13 @@ class AdaptiveSimulation final : public SimulationRun {
   /// The rest geometry the error estimate reads (recovery_geometry), computed once per cut.
   const RecoveryGeometry* cut_geometry();
   std::optional<RecoveryGeometry> m_cut_geometry;
-  /// The bound on ω² of the children of a tet at `parent` (Bey-ordered positions) that
-  /// `children` selects (bit k: child slot k; 0: the largest over every non-empty selection, which
-  /// is the largest single child's),
-  /// assembled as one group (stable_time_step.hpp). Kept by the parent's shape (its edges' squared
-  /// lengths relative to the longest, to 2⁻⁴⁰; ω² scales as the inverse square of the size), with
-  /// a relative margin of 1e-9 for shapes that share a key: the tree's tets fall into a few shapes
-  /// (Bey's refinement makes at most three similarity classes per root), so the bound of a whole
-  /// level costs a few eigen-solves.
+  /// The bound on ω² of the children of a tet at `parent` (Bey-ordered positions) that `children`
+  /// selects (bit k: child slot k), assembled as one group (stable_time_step.hpp); 0: the largest
+  /// over every non-empty selection, which is the largest single child's. Kept by the parent's
+  /// shape (its edges' squared lengths relative to the longest, to 2⁻⁴⁰; ω² scales as the inverse
+  /// square of the size), with a relative margin of 1e-9 for shapes that share a key: the tree's
+  /// tets fall into a few shapes (Bey's refinement makes at most three similarity classes per
+  /// root), so the bound of a whole level costs a few eigen-solves.
   double sibling_frequency_squared(const Matrix3x4d& parent, std::uint8_t children) const;
   /// Per parent shape: ω² × the longest squared edge, per selection of children (NaN: not yet
   /// computed; entry 0: the largest over the selections).
